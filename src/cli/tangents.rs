@@ -1,0 +1,10 @@
+//! `bumpbake tangents`: not built yet.
+
+use bumpbake::Result;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> Result<u8> {
+    Err(bumpbake::Error::usage("tangents: not built yet"))
+}

@@ -1,0 +1,23 @@
+//! bumpbake: prepares 3D assets for bump and normal mapping.
+//!
+//! The library does all the work; the `bumpbake` binary only parses arguments and reports.
+//! Every subcommand follows `docs/conventions.md` (copied from the project's shared contract).
+//!
+//! - [`scene`]: the one in-memory model every stage shares, with its readers (OBJ, glTF, GLB)
+//!   and writer (glTF, GLB).
+//! - [`tangent`]: MikkTSpace tangent frames, fallback frames, vertex split and merge.
+//! - [`normalmap`]: height maps to tangent-space normal maps.
+//! - [`validate`]: tangent-frame, handedness and normal-map checks.
+//! - [`preview`]: a CPU reference renderer of the course notes' shading model.
+//! - [`output`]: atomic writes, so that no failed run leaves a partial file.
+
+pub mod error;
+pub mod normalmap;
+pub mod output;
+pub mod preview;
+pub mod report;
+pub mod scene;
+pub mod tangent;
+pub mod validate;
+
+pub use error::{Error, Result};

@@ -1,0 +1,1 @@
+//! Height maps to tangent-space normal maps (issue: normalmap). Not built yet.

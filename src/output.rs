@@ -1,0 +1,79 @@
+//! Writing outputs safely: every file goes to a temporary name in the target directory and is
+//! renamed into place only when complete, so a failed run never leaves a partial file and never
+//! touches its input (even when the output path is the input path).
+
+use crate::error::{Error, Result};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A set of files that appear together or not at all (a `.gltf` and its `.bin`, say).
+#[derive(Default)]
+pub struct Outputs {
+    files: Vec<(PathBuf, Vec<u8>)>,
+}
+
+impl Outputs {
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Queues `bytes` to be written at `path`.
+    pub fn add(&mut self, path: impl Into<PathBuf>, bytes: Vec<u8>) {
+        self.files.push((path.into(), bytes));
+    }
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.files.iter().map(|(p, _)| p.as_path())
+    }
+    /// Writes every queued file to a temporary sibling, then renames them all into place.
+    /// If any write fails, every temporary is removed and nothing is renamed.
+    pub fn commit(self) -> Result<()> {
+        let mut temps: Vec<(PathBuf, PathBuf)> = Vec::new();
+        for (path, bytes) in &self.files {
+            match write_temp(path, bytes) {
+                Ok(tmp) => temps.push((tmp, path.clone())),
+                Err(e) => {
+                    for (tmp, _) in &temps {
+                        let _ = std::fs::remove_file(tmp);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        for (i, (tmp, path)) in temps.iter().enumerate() {
+            if let Err(e) = std::fs::rename(tmp, path) {
+                for (t, _) in &temps[i..] {
+                    let _ = std::fs::remove_file(t);
+                }
+                return Err(Error::output(path, e));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes one file atomically.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = write_temp(path, bytes)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::output(path, e)
+    })
+}
+
+fn write_temp(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path.file_name().ok_or_else(|| Error::output(path, "not a file name"))?;
+    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::output(path, e));
+    }
+    Ok(tmp)
+}

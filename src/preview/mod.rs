@@ -1,0 +1,1 @@
+//! CPU reference renderer (issue: preview). Not built yet.

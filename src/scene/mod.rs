@@ -1,0 +1,1 @@
+//! The shared in-memory model (not built yet).

@@ -1,0 +1,54 @@
+//! The MikkTSpace engine boundary. Everything above this file sees per-corner frames; only this
+//! file knows which implementation produced them, so a faster one can replace it.
+
+use super::TriMesh;
+
+/// Which implementation computes the reference frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Engine {
+    /// `bevy_mikktspace`: a safe, byte-identical port of the C reference.
+    #[default]
+    Bevy,
+}
+
+/// Per-corner MikkTSpace frames `(t.x, t.y, t.z, sign)` in the reference's own sign convention
+/// (`sign = +1` when the UV orientation is preserved), or `None` where the reference gives no
+/// answer (a degenerate triangle with no neighbour to borrow from).
+pub fn generate(mesh: &TriMesh, engine: Engine) -> Vec<Option<[f32; 4]>> {
+    match engine {
+        Engine::Bevy => generate_bevy(mesh),
+    }
+}
+
+struct BevyGeometry<'a> {
+    mesh: &'a TriMesh<'a>,
+    out: Vec<Option<[f32; 4]>>,
+}
+
+impl bevy_mikktspace::Geometry for BevyGeometry<'_> {
+    fn num_faces(&self) -> usize {
+        self.mesh.indices.len() / 3
+    }
+    fn num_vertices_of_face(&self, _face: usize) -> usize {
+        3
+    }
+    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.positions[self.mesh.indices[face * 3 + vert] as usize]
+    }
+    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.normals[self.mesh.indices[face * 3 + vert] as usize]
+    }
+    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+        self.mesh.uvs[self.mesh.indices[face * 3 + vert] as usize]
+    }
+    fn set_tangent(&mut self, ts: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
+        self.out[face * 3 + vert] = ts.map(|t| t.tangent_encoded());
+    }
+}
+
+fn generate_bevy(mesh: &TriMesh) -> Vec<Option<[f32; 4]>> {
+    let mut g = BevyGeometry { mesh, out: vec![None; mesh.indices.len()] };
+    // The error type has no variants: generation cannot fail, it can only leave corners unset.
+    let _ = bevy_mikktspace::generate_tangents(&mut g);
+    g.out
+}

@@ -1,0 +1,1 @@
+//! Tangent-space and handedness checks (issue: validate). Not built yet.
