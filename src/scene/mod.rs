@@ -1,1 +1,351 @@
-//! The shared in-memory model (not built yet).
+//! The one in-memory model every stage shares.
+//!
+//! A [`Scene`] is a glTF 2.0 document: its JSON, kept as read so that everything the tool does not
+//! touch (nodes, animations, skins, cameras, extensions, extras, names) leaves unchanged, plus the
+//! bytes of its buffers. Stages read a mesh primitive into a [`Primitive`] (dense, typed streams),
+//! change it, and put it back with [`Scene::set_primitive`]; the writer drops whatever data is no
+//! longer referenced. OBJ input is converted into the same model on reading.
+
+pub mod accessor;
+mod gltf_read;
+mod gltf_write;
+mod obj;
+pub mod uri;
+pub mod weld;
+
+pub use accessor::{Format, Stream};
+pub use gltf_write::{write, WriteOptions, WriteStats};
+pub use obj::{flat_normals, smooth_normals};
+
+use crate::error::{Error, Result};
+use accessor::*;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+/// Options that change how inputs are read.
+#[derive(Debug, Clone, Default)]
+pub struct ReadOptions {
+    /// Permit URIs that reach outside the input's folder.
+    pub allow_outside: bool,
+    /// How to make normals for OBJ meshes that have none.
+    pub obj_normals: NormalMode,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum NormalMode {
+    Flat,
+    #[default]
+    Smooth,
+}
+
+/// A glTF document in memory.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The glTF JSON root.
+    pub json: Value,
+    /// Bytes of `json.buffers`, index for index.
+    pub buffers: Vec<Vec<u8>>,
+    /// The file this scene was read from.
+    pub source: PathBuf,
+    /// The folder relative URIs resolve against.
+    pub base_dir: PathBuf,
+    /// Whether relative URIs may leave `base_dir`.
+    pub allow_outside: bool,
+    /// True while TEXCOORD data holds OBJ UVs (v up); the writer flips them to glTF's v down.
+    pub uv_v_up: bool,
+    /// The images were gathered by bumpbake (from an MTL), not authored as glTF: the writer stores
+    /// them in the buffer and drops PNG colour-space chunks glTF does not allow.
+    pub own_images: bool,
+    /// What the reader noticed and the user should hear (e.g. height maps left for `bake`).
+    pub notes: Vec<String>,
+    /// Height maps named by OBJ `bump`/`map_Bump`, which only `bake` can turn into normal maps.
+    pub height_maps: Vec<HeightMapRef>,
+}
+
+/// A height map a material wants as its bump map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeightMapRef {
+    pub material: usize,
+    pub path: PathBuf,
+    /// The MTL `-bm` multiplier.
+    pub multiplier: f32,
+}
+
+/// A mesh primitive, dense and decoded: the unit every tangent stage works on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Primitive {
+    /// Attribute streams in the order the file lists them.
+    pub attributes: Vec<(String, Stream)>,
+    /// Morph targets, each a list of attribute streams.
+    pub targets: Vec<Vec<(String, Stream)>>,
+    /// Index list (made explicit for non-indexed primitives).
+    pub indices: Vec<u32>,
+    /// glTF primitive mode (4 = triangles).
+    pub mode: u32,
+}
+
+impl Primitive {
+    pub fn attr(&self, name: &str) -> Option<&Stream> {
+        self.attributes.iter().find(|(n, _)| n == name).map(|(_, s)| s)
+    }
+    /// Replaces the stream called `name`, or appends it.
+    pub fn set_attr(&mut self, name: &str, stream: Stream) {
+        match self.attributes.iter_mut().find(|(n, _)| n == name) {
+            Some(slot) => slot.1 = stream,
+            None => self.attributes.push((name.to_string(), stream)),
+        }
+    }
+    pub fn remove_attr(&mut self, name: &str) -> Option<Stream> {
+        let i = self.attributes.iter().position(|(n, _)| n == name)?;
+        Some(self.attributes.remove(i).1)
+    }
+    pub fn vertex_count(&self) -> usize {
+        self.attributes.first().map(|(_, s)| s.len()).unwrap_or(0)
+    }
+    pub fn positions(&self) -> Vec<[f32; 3]> {
+        self.attr("POSITION").map(|s| s.to_f32()).unwrap_or_default()
+    }
+}
+
+/// Where a primitive sits in the document.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+pub struct PrimRef {
+    pub mesh: usize,
+    pub primitive: usize,
+}
+
+impl Scene {
+    /// Reads an `.obj`, `.gltf` or `.glb` file (GLB is recognised by its magic, not its name).
+    pub fn read(path: &Path, opts: &ReadOptions) -> Result<Scene> {
+        let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        if ext == "obj" {
+            obj::read(path, &bytes, opts)
+        } else if bytes.starts_with(b"glTF") || ext == "glb" {
+            gltf_read::read_glb(path, &bytes, opts)
+        } else if ext == "gltf" || bytes.first().map(|b| *b == b'{').unwrap_or(false) {
+            gltf_read::read_gltf(path, &bytes, opts)
+        } else {
+            Err(Error::input(path, "unknown mesh format (expected .obj, .gltf or .glb)"))
+        }
+    }
+
+    /// An error about this scene's file.
+    pub fn err(&self, msg: impl Into<String>) -> Error {
+        Error::input(&self.source, msg)
+    }
+
+    fn array(&self, key: &str) -> &[Value] {
+        self.json.get(key).and_then(|v| v.as_array()).map(|v| v.as_slice()).unwrap_or(&[])
+    }
+
+    /// Every mesh primitive, in document order.
+    pub fn primitives(&self) -> Vec<PrimRef> {
+        let mut out = Vec::new();
+        for (m, mesh) in self.array("meshes").iter().enumerate() {
+            let n = mesh.get("primitives").and_then(|p| p.as_array()).map(|p| p.len()).unwrap_or(0);
+            out.extend((0..n).map(|p| PrimRef { mesh: m, primitive: p }));
+        }
+        out
+    }
+
+    pub fn prim_json(&self, r: PrimRef) -> &Value {
+        &self.json["meshes"][r.mesh]["primitives"][r.primitive]
+    }
+
+    fn prim_json_mut(&mut self, r: PrimRef) -> &mut Value {
+        &mut self.json["meshes"][r.mesh]["primitives"][r.primitive]
+    }
+
+    /// The material JSON of a primitive, if it has one.
+    pub fn material_of(&self, r: PrimRef) -> Option<&Value> {
+        let m = self.prim_json(r).get("material")?.as_u64()? as usize;
+        self.array("materials").get(m)
+    }
+
+    /// The UV set the primitive's normal texture reads, if its material has one
+    /// (`KHR_texture_transform` may override `texCoord`).
+    pub fn normal_texcoord(&self, r: PrimRef) -> Option<u32> {
+        let nt = self.material_of(r)?.get("normalTexture")?;
+        let over = nt.pointer("/extensions/KHR_texture_transform/texCoord").and_then(|v| v.as_u64());
+        Some(over.or_else(|| nt.get("texCoord").and_then(|v| v.as_u64())).unwrap_or(0) as u32)
+    }
+
+    /// Reads a primitive's streams, indices and morph targets.
+    pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
+        let pj = self.prim_json(r);
+        let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
+        let attrs = pj
+            .get("attributes")
+            .and_then(|a| a.as_object())
+            .ok_or_else(|| self.err(format!("{where_}: no attributes")))?;
+        let mut attributes = Vec::new();
+        for (name, idx) in attrs {
+            let idx = as_index(idx).ok_or_else(|| self.err(format!("{where_}: attribute {name} is not an accessor index")))?;
+            attributes.push((name.clone(), self.accessor(idx)?));
+        }
+        let mut targets = Vec::new();
+        if let Some(ts) = pj.get("targets").and_then(|t| t.as_array()) {
+            for t in ts {
+                let mut streams = Vec::new();
+                for (name, idx) in t.as_object().into_iter().flatten() {
+                    let idx = as_index(idx).ok_or_else(|| self.err(format!("{where_}: morph target {name} is not an accessor index")))?;
+                    streams.push((name.clone(), self.accessor(idx)?));
+                }
+                targets.push(streams);
+            }
+        }
+        let count = attributes.first().map(|(_, s)| s.len()).unwrap_or(0);
+        if let Some((_, pos)) = attributes.iter().find(|(n, _)| n == "POSITION") {
+            if let Some(bad) = pos.to_f32::<3>().iter().position(|v| !v.iter().all(|x| x.is_finite())) {
+                return Err(self.err(format!("{where_}: POSITION {bad} is not finite (NaN or infinity)")));
+            }
+        }
+        for (name, s) in attributes.iter().chain(targets.iter().flatten()) {
+            if s.len() != count {
+                return Err(self.err(format!("{where_}: attribute {name} has {} elements, POSITION has {count}", s.len())));
+            }
+        }
+        let indices = match pj.get("indices") {
+            Some(i) => {
+                let idx = as_index(i).ok_or_else(|| self.err(format!("{where_}: indices is not an accessor index")))?;
+                let s = self.accessor(idx)?;
+                if s.format.ty != "SCALAR" || !matches!(s.format.component_type, UNSIGNED_BYTE | UNSIGNED_SHORT | UNSIGNED_INT) {
+                    return Err(self.err(format!("{where_}: index accessor {idx} is not an unsigned integer scalar")));
+                }
+                let v: Vec<u32> = (0..s.len()).map(|i| s.get(i, 0) as u32).collect();
+                if let Some((k, bad)) = v.iter().enumerate().find(|(_, &x)| x as usize >= count) {
+                    return Err(self.err(format!("{where_}: index {bad} at position {k} is out of range (the primitive has {count} vertices)")));
+                }
+                v
+            }
+            None => (0..count as u32).collect(),
+        };
+        let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4) as u32;
+        Ok(Primitive { attributes, targets, indices, mode })
+    }
+
+    /// Reads an accessor into a dense stream (sparse substitution applied).
+    pub fn accessor(&self, idx: usize) -> Result<Stream> {
+        gltf_read::read_accessor(self, idx)
+    }
+
+    /// Puts a primitive back: its streams become new accessors in a new buffer, and the
+    /// primitive's JSON points at them. Old accessors are left for the writer to drop.
+    pub fn set_primitive(&mut self, r: PrimRef, p: &Primitive) {
+        let mut attrs = serde_json::Map::new();
+        for (name, s) in &p.attributes {
+            let i = self.push_accessor(s, Some(34962), name == "POSITION");
+            attrs.insert(name.clone(), json!(i));
+        }
+        let mut targets = Vec::new();
+        for t in &p.targets {
+            let mut m = serde_json::Map::new();
+            for (name, s) in t {
+                let i = self.push_accessor(s, Some(34962), name == "POSITION");
+                m.insert(name.clone(), json!(i));
+            }
+            targets.push(Value::Object(m));
+        }
+        let index_stream = index_stream(&p.indices, p.vertex_count());
+        let old_indices = self.prim_json(r).get("indices").and_then(as_index);
+        let mut index_stream = index_stream;
+        index_stream.template = old_indices.and_then(|i| self.array("accessors").get(i).cloned());
+        let ii = self.push_accessor(&index_stream, Some(34963), false);
+        let pj = self.prim_json_mut(r);
+        pj["attributes"] = Value::Object(attrs);
+        pj["indices"] = json!(ii);
+        if !p.targets.is_empty() {
+            pj["targets"] = Value::Array(targets);
+        }
+        if let Some(o) = pj.as_object_mut() {
+            if p.mode == 4 {
+                o.remove("mode");
+            } else {
+                o.insert("mode".into(), json!(p.mode));
+            }
+        }
+    }
+
+    /// Appends a stream as a new buffer view + accessor; returns the accessor index.
+    pub fn push_accessor(&mut self, s: &Stream, target: Option<u32>, min_max: bool) -> usize {
+        if self.buffers.is_empty() || self.json.pointer("/buffers/0").is_none() {
+            self.buffers.clear();
+            self.json["buffers"] = json!([{ "byteLength": 0 }]);
+            self.buffers.push(Vec::new());
+        }
+        // New data goes into the last buffer; the writer repacks everything into one anyway.
+        let b = self.buffers.len() - 1;
+        let buf = &mut self.buffers[b];
+        while buf.len() % 4 != 0 {
+            buf.push(0);
+        }
+        let offset = buf.len();
+        buf.extend_from_slice(&s.data);
+        let len = buf.len();
+        self.json["buffers"][b]["byteLength"] = json!(len);
+        let mut view = json!({ "buffer": b, "byteOffset": offset, "byteLength": s.data.len() });
+        if let Some(t) = target {
+            view["target"] = json!(t);
+        }
+        let views = array_mut(&mut self.json, "bufferViews");
+        views.push(view);
+        let vi = views.len() - 1;
+        let mut acc = json!({
+            "bufferView": vi,
+            "componentType": s.format.component_type,
+            "count": s.len(),
+            "type": s.format.ty,
+        });
+        if s.format.normalized {
+            acc["normalized"] = json!(true);
+        }
+        if let Some(t) = &s.template {
+            for key in ["name", "extras"] {
+                if let Some(v) = t.get(key) {
+                    acc[key] = v.clone();
+                }
+            }
+        }
+        if min_max && s.len() > 0 {
+            let n = s.format.components();
+            let mut lo = vec![f32::INFINITY; n];
+            let mut hi = vec![f32::NEG_INFINITY; n];
+            for i in 0..s.len() {
+                for c in 0..n {
+                    let v = s.get(i, c);
+                    lo[c] = lo[c].min(v);
+                    hi[c] = hi[c].max(v);
+                }
+            }
+            acc["min"] = json!(lo);
+            acc["max"] = json!(hi);
+        }
+        let accs = array_mut(&mut self.json, "accessors");
+        accs.push(acc);
+        accs.len() - 1
+    }
+}
+
+/// The smallest index stream glTF allows for `vertex_count` vertices (never 8-bit; 16-bit only
+/// below 65535, which is reserved as primitive restart).
+fn index_stream(indices: &[u32], vertex_count: usize) -> Stream {
+    if vertex_count < 65535 {
+        let data = indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect();
+        Stream { format: Format { component_type: UNSIGNED_SHORT, ty: "SCALAR".into(), normalized: false }, data, template: None }
+    } else {
+        let data = indices.iter().flat_map(|&i| i.to_le_bytes()).collect();
+        Stream { format: Format { component_type: UNSIGNED_INT, ty: "SCALAR".into(), normalized: false }, data, template: None }
+    }
+}
+
+pub(crate) fn as_index(v: &Value) -> Option<usize> {
+    v.as_u64().map(|i| i as usize)
+}
+
+pub(crate) fn array_mut<'a>(root: &'a mut Value, key: &str) -> &'a mut Vec<Value> {
+    if !root.get(key).map(|v| v.is_array()).unwrap_or(false) {
+        root[key] = json!([]);
+    }
+    root[key].as_array_mut().expect("just made an array")
+}

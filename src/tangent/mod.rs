@@ -1,7 +1,17 @@
 //! Tangent frames: MikkTSpace generation ([`mikk`]), the fallback for corners the reference
-//! leaves undefined ([`fallback`]), and the split/merge of vertices that follows ([`split`]).
+//! leaves undefined ([`fallback`]), and applying both to a primitive, splitting vertices whose
+//! corners got different frames and merging identical ones ([`primitive_with_tangents`]).
+//! [`apply`] decides which primitives of a scene need tangents.
 
+pub mod apply;
+pub mod command;
+pub mod fallback;
 pub mod mikk;
+
+use crate::scene::weld::{unweld, weld};
+use crate::scene::{flat_normals, Primitive, Stream};
+use fallback::FallbackCounts;
+use glam::Vec3;
 
 /// An indexed triangle list as MikkTSpace sees it: one normal and one UV per vertex.
 #[derive(Debug, Clone, Copy)]
@@ -11,4 +21,87 @@ pub struct TriMesh<'a> {
     pub uvs: &'a [[f32; 2]],
     /// Three indices per triangle, each `< positions.len()`.
     pub indices: &'a [u32],
+}
+
+/// How frames are made.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Options {
+    /// Also write `_BITANGENT = cross(N, T) * w`.
+    pub bitangents: bool,
+    pub engine: mikk::Engine,
+}
+
+/// What happened to one primitive.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct FrameStats {
+    pub vertices_in: usize,
+    pub vertices_out: usize,
+    pub triangles: usize,
+    /// NORMAL was missing and flat normals were made, as the glTF spec asks of a client.
+    pub generated_normals: bool,
+    pub fallback: FallbackCounts,
+}
+
+/// The primitive with MikkTSpace tangents from UV set `uv_set`.
+///
+/// `uv_v_up` says the UVs follow OBJ's convention (v up): the reference sign is kept. For glTF UVs
+/// (v down) they are fed as stored and `w` is the negated reference sign (see the conventions).
+/// The primitive must be a triangle list with that UV set; its old TANGENT is replaced.
+pub fn primitive_with_tangents(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> Primitive {
+    primitive_with_stats(p, uv_set, uv_v_up, opts).0
+}
+
+/// [`primitive_with_tangents`], with what it did.
+pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
+    let uv_name = format!("TEXCOORD_{uv_set}");
+    let positions = p.positions();
+    let uvs: Vec<[f32; 2]> = p.attr(&uv_name).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
+    let (mut corners, targets) = unweld(p);
+    corners.retain(|(n, _)| n != "TANGENT" && n != "_BITANGENT");
+
+    // Corner-level normals: the vertex normals, or flat ones when the primitive has none.
+    let generated_normals = p.attr("NORMAL").is_none();
+    let (mesh_normals, corner_normals): (Vec<[f32; 3]>, Vec<[f32; 3]>) = if generated_normals {
+        let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
+        let (n, _) = flat_normals(&cp);
+        corners.insert(1.min(corners.len()), ("NORMAL".into(), Stream::from_f32("VEC3", &n)));
+        (n.clone(), n)
+    } else {
+        let n: Vec<[f32; 3]> = p.attr("NORMAL").map(|s| s.to_f32()).unwrap_or_default();
+        let cn = p.indices.iter().map(|&i| n[i as usize]).collect();
+        (n, cn)
+    };
+
+    // MikkTSpace only sees values per corner, so unwelded (flat-normal) input is equivalent.
+    let frames = if generated_normals {
+        let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
+        let cu: Vec<[f32; 2]> = p.indices.iter().map(|&i| uvs[i as usize]).collect();
+        let idx: Vec<u32> = (0..p.indices.len() as u32).collect();
+        mikk::generate(&TriMesh { positions: &cp, normals: &mesh_normals, uvs: &cu, indices: &idx }, opts.engine)
+    } else {
+        mikk::generate(&TriMesh { positions: &positions, normals: &mesh_normals, uvs: &uvs, indices: &p.indices }, opts.engine)
+    };
+    let flip = if uv_v_up { 1.0 } else { -1.0 };
+    let mut frames: Vec<Option<[f32; 4]>> = frames.into_iter().map(|f| f.map(|t| [t[0], t[1], t[2], t[3] * flip])).collect();
+    let normals_v: Vec<Vec3> = corner_normals.iter().map(|&n| Vec3::from(n)).collect();
+    let (tangents, fallback) = fallback::repair(&mut frames, &normals_v, &p.indices);
+
+    corners.push(("TANGENT".into(), Stream::from_f32("VEC4", &tangents)));
+    if opts.bitangents {
+        let b: Vec<[f32; 3]> = tangents
+            .iter()
+            .zip(&normals_v)
+            .map(|(t, n)| (n.normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3]).to_array())
+            .collect();
+        corners.push(("_BITANGENT".into(), Stream::from_f32("VEC3", &b)));
+    }
+    let out = weld(corners, targets, 4);
+    let stats = FrameStats {
+        vertices_in: p.vertex_count(),
+        vertices_out: out.vertex_count(),
+        triangles: p.indices.len() / 3,
+        generated_normals,
+        fallback,
+    };
+    (out, stats)
 }

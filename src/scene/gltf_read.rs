@@ -1,0 +1,194 @@
+//! Reading `.gltf` and `.glb` into a [`Scene`], checking every reference before it is followed.
+
+use super::accessor::*;
+use super::{as_index, uri, ReadOptions, Scene};
+use crate::error::{Error, Result};
+use serde_json::Value;
+use std::path::Path;
+
+const GLB_JSON: u32 = 0x4E4F534A;
+const GLB_BIN: u32 = 0x004E4942;
+
+pub fn read_glb(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
+    let bad = |m: String| Error::input(path, m);
+    if bytes.len() < 12 {
+        return Err(bad(format!("truncated GLB: {} bytes, the header alone needs 12", bytes.len())));
+    }
+    if &bytes[0..4] != b"glTF" {
+        return Err(bad("not a GLB file (wrong magic)".into()));
+    }
+    let word = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    let version = word(4);
+    if version != 2 {
+        return Err(bad(format!("GLB container version {version} is not supported (only glTF 2.0)")));
+    }
+    let total = word(8) as usize;
+    if total > bytes.len() {
+        return Err(bad(format!("truncated GLB: header says {total} bytes, file has {}", bytes.len())));
+    }
+    let mut at = 12;
+    let mut json_chunk: Option<&[u8]> = None;
+    let mut bin: Option<&[u8]> = None;
+    while at + 8 <= total {
+        let len = word(at) as usize;
+        let kind = word(at + 4);
+        let start = at + 8;
+        let end = start.checked_add(len).filter(|&e| e <= total).ok_or_else(|| {
+            bad(format!("truncated GLB: chunk at byte {at} claims {len} bytes past the end of the file"))
+        })?;
+        match kind {
+            GLB_JSON if json_chunk.is_none() => json_chunk = Some(&bytes[start..end]),
+            GLB_BIN if bin.is_none() && json_chunk.is_some() => bin = Some(&bytes[start..end]),
+            _ => {}
+        }
+        at = end + (4 - end % 4) % 4;
+    }
+    let json_bytes = json_chunk.ok_or_else(|| bad("GLB has no JSON chunk".into()))?;
+    let json = parse_json(path, json_bytes)?;
+    build(path, json, bin.map(|b| b.to_vec()), opts)
+}
+
+pub fn read_gltf(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
+    let json = parse_json(path, bytes)?;
+    build(path, json, None, opts)
+}
+
+fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value> {
+    let v: Value = serde_json::from_slice(bytes).map_err(|e| Error::input(path, format!("invalid JSON: {e}")))?;
+    if !v.is_object() {
+        return Err(Error::input(path, "glTF JSON is not an object"));
+    }
+    let version = v.pointer("/asset/version").and_then(|v| v.as_str());
+    match version {
+        Some(s) if s.starts_with("2.") => Ok(v),
+        Some(s) => Err(Error::input(path, format!("glTF version {s} is not supported (only 2.x)"))),
+        None => Err(Error::input(path, "missing asset.version (is this glTF 1.0?)")),
+    }
+}
+
+fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> Result<Scene> {
+    let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+    let mut buffers = Vec::new();
+    let mut bin = bin;
+    let list = json.get("buffers").and_then(|b| b.as_array()).cloned().unwrap_or_default();
+    for (i, b) in list.iter().enumerate() {
+        let declared = b.get("byteLength").and_then(|l| l.as_u64()).ok_or_else(|| {
+            Error::input(path, format!("buffer {i} has no byteLength"))
+        })? as usize;
+        let data = match b.get("uri").and_then(|u| u.as_str()) {
+            Some(u) => uri::read(u, &base_dir, path, opts.allow_outside)?,
+            None if i == 0 => bin.take().ok_or_else(|| Error::input(path, "buffer 0 has no uri and there is no GLB binary chunk"))?,
+            None => return Err(Error::input(path, format!("buffer {i} has no uri"))),
+        };
+        if data.len() < declared {
+            return Err(Error::input(path, format!("buffer {i} holds {} bytes, byteLength says {declared}", data.len())));
+        }
+        buffers.push(data);
+    }
+    let scene = Scene {
+        json,
+        buffers,
+        source: path.to_path_buf(),
+        base_dir,
+        allow_outside: opts.allow_outside,
+        uv_v_up: false,
+        notes: Vec::new(),
+        height_maps: Vec::new(),
+        own_images: false,
+    };
+    check_views(&scene)?;
+    Ok(scene)
+}
+
+/// Every buffer view must lie inside its buffer; checked once so accessor reads can trust them.
+fn check_views(s: &Scene) -> Result<()> {
+    for (i, v) in s.array("bufferViews").iter().enumerate() {
+        let b = v.get("buffer").and_then(as_index).ok_or_else(|| s.err(format!("bufferView {i} has no buffer")))?;
+        let buf = s.buffers.get(b).ok_or_else(|| s.err(format!("bufferView {i} names buffer {b}, which does not exist")))?;
+        let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0);
+        let len = v.get("byteLength").and_then(|o| o.as_u64()).ok_or_else(|| s.err(format!("bufferView {i} has no byteLength")))?;
+        if off.checked_add(len).map(|e| e > buf.len() as u64).unwrap_or(true) {
+            return Err(s.err(format!("bufferView {i} (bytes {off}..{}) runs past the end of buffer {b} ({} bytes)", off.saturating_add(len), buf.len())));
+        }
+    }
+    Ok(())
+}
+
+/// The bytes of a buffer view, already checked to be in range.
+fn view_bytes(s: &Scene, view: usize) -> Result<(&[u8], Option<usize>)> {
+    let v = s.array("bufferViews").get(view).ok_or_else(|| s.err(format!("bufferView {view} does not exist")))?;
+    let b = v.get("buffer").and_then(as_index).unwrap_or(0);
+    let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let stride = v.get("byteStride").and_then(|o| o.as_u64()).map(|x| x as usize);
+    Ok((&s.buffers[b][off..off + len], stride))
+}
+
+pub fn read_accessor(s: &Scene, idx: usize) -> Result<Stream> {
+    let a = s.array("accessors").get(idx).ok_or_else(|| s.err(format!("accessor {idx} does not exist")))?;
+    let ct = a.get("componentType").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
+    let ty = a.get("type").and_then(|t| t.as_str()).unwrap_or("");
+    let count = a.get("count").and_then(|c| c.as_u64()).ok_or_else(|| s.err(format!("accessor {idx} has no count")))? as usize;
+    let format = Format { component_type: ct, ty: ty.to_string(), normalized: a.get("normalized").and_then(|n| n.as_bool()).unwrap_or(false) };
+    let (Some(_), Some(_)) = (component_size(ct), component_count(ty)) else {
+        return Err(s.err(format!("accessor {idx} has an unknown componentType {ct} or type '{ty}'")));
+    };
+    let es = format.elem_size();
+    let total = count.checked_mul(es).filter(|&t| t <= 1 << 31).ok_or_else(|| s.err(format!("accessor {idx}: count {count} is absurd")))?;
+    let mut data = vec![0u8; 0];
+    match a.get("bufferView").and_then(as_index) {
+        Some(view) => {
+            let (bytes, stride) = view_bytes(s, view)?;
+            let off = a.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+            let stride = stride.unwrap_or(es).max(es);
+            // Matrices of 1- and 2-byte components pad each column to 4 bytes.
+            let col_pad = matches!(ty, "MAT2" | "MAT3" | "MAT4") && component_size(ct).unwrap_or(4) < 4;
+            if col_pad {
+                return Err(s.err(format!("accessor {idx}: padded matrix layouts are not supported")));
+            }
+            let need = if count == 0 { 0 } else { off + stride * (count - 1) + es };
+            if need > bytes.len() {
+                return Err(s.err(format!("accessor {idx} needs {need} bytes of bufferView {view}, which has {}", bytes.len())));
+            }
+            data.reserve(total);
+            for i in 0..count {
+                let at = off + i * stride;
+                data.extend_from_slice(&bytes[at..at + es]);
+            }
+        }
+        None => data.resize(total, 0),
+    }
+    if let Some(sp) = a.get("sparse") {
+        apply_sparse(s, idx, sp, es, count, &mut data)?;
+    }
+    Ok(Stream { format, data, template: Some(a.clone()) })
+}
+
+fn apply_sparse(s: &Scene, idx: usize, sp: &Value, es: usize, count: usize, data: &mut [u8]) -> Result<()> {
+    let n = sp.get("count").and_then(|c| c.as_u64()).unwrap_or(0) as usize;
+    let bad = |m: &str| s.err(format!("accessor {idx}: sparse {m}"));
+    let iv = sp.pointer("/indices/bufferView").and_then(as_index).ok_or_else(|| bad("indices without bufferView"))?;
+    let ioff = sp.pointer("/indices/byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let ict = sp.pointer("/indices/componentType").and_then(|o| o.as_u64()).unwrap_or(0) as u32;
+    let ics = component_size(ict).ok_or_else(|| bad("indices have an unknown componentType"))?;
+    let vv = sp.pointer("/values/bufferView").and_then(as_index).ok_or_else(|| bad("values without bufferView"))?;
+    let voff = sp.pointer("/values/byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let (ib, _) = view_bytes(s, iv)?;
+    let (vb, _) = view_bytes(s, vv)?;
+    if ioff + n * ics > ib.len() || voff + n * es > vb.len() {
+        return Err(bad("data runs past its bufferView"));
+    }
+    for k in 0..n {
+        let at = ioff + k * ics;
+        let i = match ics {
+            1 => ib[at] as usize,
+            2 => u16::from_le_bytes([ib[at], ib[at + 1]]) as usize,
+            _ => u32::from_le_bytes([ib[at], ib[at + 1], ib[at + 2], ib[at + 3]]) as usize,
+        };
+        if i >= count {
+            return Err(bad(&format!("index {i} is past the accessor's count {count}")));
+        }
+        data[i * es..(i + 1) * es].copy_from_slice(&vb[voff + k * es..voff + (k + 1) * es]);
+    }
+    Ok(())
+}

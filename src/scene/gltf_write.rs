@@ -1,0 +1,411 @@
+//! Writing a [`Scene`] as `.gltf` (+ `.bin`) or `.glb`.
+//!
+//! The writer keeps only the accessors and buffer views something still references, repacks them
+//! into one buffer, and renumbers the references. Anything it cannot prove unreferenced (data an
+//! unknown extension might point at) is kept.
+
+use super::{as_index, uri, Scene};
+use crate::error::{Error, Result};
+use crate::output::Outputs;
+use base64::Engine as _;
+use serde_json::{json, Value};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// Extensions known not to reference accessors or buffer views (or whose references we follow).
+const KNOWN_EXTENSIONS: &[&str] = &[
+    "KHR_texture_transform",
+    "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_iridescence",
+    "KHR_materials_sheen",
+    "KHR_materials_specular",
+    "KHR_materials_transmission",
+    "KHR_materials_unlit",
+    "KHR_materials_variants",
+    "KHR_materials_volume",
+    "KHR_materials_anisotropy",
+    "KHR_materials_dispersion",
+    "KHR_materials_pbrSpecularGlossiness",
+    "KHR_mesh_quantization",
+    "KHR_texture_basisu",
+    "EXT_texture_webp",
+    "EXT_mesh_gpu_instancing",
+    "KHR_xmp_json_ld",
+    "KHR_animation_pointer",
+];
+
+#[derive(Debug, Clone, Default)]
+pub struct WriteOptions {
+    /// For `.gltf`: put buffers and images inside the JSON as data URIs.
+    pub embed: bool,
+}
+
+/// What the writer did, for the report.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct WriteStats {
+    pub accessors_dropped: usize,
+    pub buffer_views_dropped: usize,
+    pub buffer_bytes_in: usize,
+    pub buffer_bytes_out: usize,
+}
+
+/// Builds every file the output consists of; the caller commits them (atomically, together).
+pub fn write(scene: &Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs, WriteStats)> {
+    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let glb = match ext.as_str() {
+        "glb" => true,
+        "gltf" => false,
+        _ => return Err(Error::usage(format!("{}: output must end in .gltf or .glb", out.display()))),
+    };
+    let flipped;
+    let scene = if scene.uv_v_up {
+        flipped = super::obj::flip_uvs_to_gltf(scene)?;
+        &flipped
+    } else {
+        scene
+    };
+    let mut json = scene.json.clone();
+    let mut stats = WriteStats { buffer_bytes_in: scene.buffers.iter().map(|b| b.len()).sum(), ..Default::default() };
+    let keep_all = uses_unknown_extension(&json);
+    let mut bin: Vec<u8> = Vec::new();
+    let mut files = Outputs::new();
+    let out_dir = out.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+
+    // Accessors.
+    let n_acc = json.get("accessors").and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0);
+    let acc_keep: BTreeSet<usize> = if keep_all { (0..n_acc).collect() } else { accessor_refs(&mut json, &mut |_| {}) };
+    check_refs(scene, "accessor", &acc_keep, n_acc)?;
+    let acc_map = renumber(&mut json, "accessors", &acc_keep);
+    accessor_refs(&mut json, &mut |i| *i = acc_map[*i].expect("kept accessor"));
+    stats.accessors_dropped = n_acc - acc_keep.len();
+
+    // Images: embed or copy what URIs name, before buffer views are renumbered.
+    let images = json.get("images").and_then(|i| i.as_array()).cloned().unwrap_or_default();
+    let mut new_images = Vec::with_capacity(images.len());
+    let mut pending_views: Vec<(Vec<u8>, usize)> = Vec::new();
+    for (i, img) in images.iter().enumerate() {
+        let mut img = img.clone();
+        if let Some(u) = img.get("uri").and_then(|u| u.as_str()).map(|s| s.to_string()) {
+            let is_data = u.starts_with("data:");
+            if glb || opts.embed || is_data || scene.own_images {
+                let mut bytes = uri::read(&u, &scene.base_dir, &scene.source, scene.allow_outside)?;
+                if scene.own_images {
+                    bytes = strip_png_colour_chunks(bytes);
+                }
+                let mime = img.get("mimeType").and_then(|m| m.as_str()).map(|s| s.to_string()).unwrap_or_else(|| sniff_mime(&bytes, &u));
+                if glb || scene.own_images {
+                    let o = img.as_object_mut().expect("image is an object");
+                    o.remove("uri");
+                    o.insert("mimeType".into(), json!(mime));
+                    pending_views.push((bytes, i));
+                } else if opts.embed {
+                    img["uri"] = json!(format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(&bytes)));
+                }
+            } else {
+                copy_beside(&mut img, &u, scene, &out_dir, &mut files)?;
+            }
+        }
+        new_images.push(img);
+    }
+    if !images.is_empty() {
+        json["images"] = Value::Array(new_images);
+    }
+
+    // Buffer views: keep what kept accessors, images and compressed primitives use; repack.
+    let n_views = json.get("bufferViews").and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0);
+    let view_keep: BTreeSet<usize> = if keep_all { (0..n_views).collect() } else { view_refs(&mut json, &mut |_| {}) };
+    check_refs(scene, "bufferView", &view_keep, n_views)?;
+    let view_map = renumber(&mut json, "bufferViews", &view_keep);
+    view_refs(&mut json, &mut |i| *i = view_map[*i].expect("kept view"));
+    stats.buffer_views_dropped = n_views - view_keep.len();
+    if let Some(views) = json.get_mut("bufferViews").and_then(|v| v.as_array_mut()) {
+        for v in views.iter_mut() {
+            let b = v.get("buffer").and_then(as_index).unwrap_or(0);
+            let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+            let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+            let src = scene.buffers.get(b).and_then(|buf| buf.get(off..off + len)).ok_or_else(|| scene.err("bufferView runs past its buffer"))?;
+            pad4(&mut bin, 0);
+            let at = bin.len();
+            bin.extend_from_slice(src);
+            v["buffer"] = json!(0);
+            set_offset(v, at);
+        }
+    }
+    for (bytes, img) in pending_views {
+        pad4(&mut bin, 0);
+        let at = bin.len();
+        bin.extend_from_slice(&bytes);
+        let views = super::array_mut(&mut json, "bufferViews");
+        let mut v = json!({ "buffer": 0, "byteLength": bytes.len() });
+        set_offset(&mut v, at);
+        views.push(v);
+        json["images"][img]["bufferView"] = json!(views_len(&json) - 1);
+    }
+    stats.buffer_bytes_out = bin.len();
+
+    // One buffer, or none.
+    let root = json.as_object_mut().ok_or_else(|| scene.err("glTF JSON is not an object"))?;
+    if bin.is_empty() && !root.contains_key("bufferViews") {
+        root.remove("buffers");
+    } else {
+        let mut b = json!({ "byteLength": bin.len() });
+        if !glb {
+            if opts.embed {
+                b["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin)));
+            } else {
+                let name = format!("{}.bin", out.file_stem().and_then(|s| s.to_str()).unwrap_or("scene"));
+                b["uri"] = json!(name);
+                files.add(out_dir.join(&name), std::mem::take(&mut bin));
+            }
+        }
+        root.insert("buffers".into(), json!([b]));
+    }
+    for key in ["accessors", "bufferViews", "images"] {
+        if root.get(key).and_then(|a| a.as_array()).map(|a| a.is_empty()).unwrap_or(false) {
+            root.remove(key);
+        }
+    }
+
+    if glb {
+        files.add(out, glb_bytes(&json, &bin));
+    } else {
+        let mut text = serde_json::to_vec_pretty(&json).map_err(|e| Error::output(out, e))?;
+        text.push(b'\n');
+        files.add(out, text);
+    }
+    Ok((files, stats))
+}
+
+fn check_refs(scene: &Scene, what: &str, refs: &BTreeSet<usize>, n: usize) -> Result<()> {
+    match refs.iter().next_back() {
+        Some(&i) if i >= n => Err(scene.err(format!("{what} {i} is referenced but does not exist ({n} in the file)"))),
+        _ => Ok(()),
+    }
+}
+
+fn views_len(json: &Value) -> usize {
+    json.get("bufferViews").and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0)
+}
+
+fn set_offset(v: &mut Value, at: usize) {
+    if at == 0 {
+        if let Some(o) = v.as_object_mut() {
+            o.remove("byteOffset");
+        }
+    } else {
+        v["byteOffset"] = json!(at);
+    }
+}
+
+fn pad4(buf: &mut Vec<u8>, fill: u8) {
+    while buf.len() % 4 != 0 {
+        buf.push(fill);
+    }
+}
+
+fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).expect("a Value always serialises");
+    pad4(&mut j, b' ');
+    let mut b = bin.to_vec();
+    pad4(&mut b, 0);
+    let has_bin = !b.is_empty() || json.get("buffers").is_some();
+    let total = 12 + 8 + j.len() + if has_bin { 8 + b.len() } else { 0 };
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(&0x4E4F534Au32.to_le_bytes());
+    out.extend_from_slice(&j);
+    if has_bin {
+        out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+        out.extend_from_slice(&0x004E4942u32.to_le_bytes());
+        out.extend_from_slice(&b);
+    }
+    out
+}
+
+/// Copies an external image next to the output (unless it is already there).
+fn copy_beside(img: &mut Value, u: &str, scene: &Scene, out_dir: &Path, files: &mut Outputs) -> Result<()> {
+    let src = match uri::resolve(u, &scene.base_dir, &scene.source, scene.allow_outside)? {
+        uri::Target::File(p) => p,
+        uri::Target::Data { .. } => return Ok(()),
+    };
+    // A URI that climbs out of the folder (allowed by the user) lands beside the output by name.
+    let rel = if u.contains("..") || u.starts_with('/') {
+        let name = src.file_name().and_then(|n| n.to_str()).unwrap_or("image").to_string();
+        img["uri"] = json!(name.clone());
+        name
+    } else {
+        u.to_string()
+    };
+    let dst = out_dir.join(super::uri::decoded_path(&rel));
+    let same = match (std::fs::canonicalize(&src), std::fs::canonicalize(&dst)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if !same {
+        let bytes = std::fs::read(&src).map_err(|e| scene.err(format!("cannot read image '{u}': {e}")))?;
+        files.add(dst, bytes);
+    }
+    Ok(())
+}
+
+/// Drops the PNG chunks that make the Khronos validator warn (colour profiles, gamma,
+/// chromaticities, pixel aspect): glTF defines the colour space itself. Non-PNG bytes pass through.
+fn strip_png_colour_chunks(bytes: Vec<u8>) -> Vec<u8> {
+    if !bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        return bytes;
+    }
+    let mut out = bytes[..8].to_vec();
+    let mut at = 8;
+    while at + 12 <= bytes.len() {
+        let len = u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]) as usize;
+        let end = match at.checked_add(12 + len) {
+            Some(e) if e <= bytes.len() => e,
+            _ => return bytes,
+        };
+        let kind = &bytes[at + 4..at + 8];
+        if !matches!(kind, b"iCCP" | b"cHRM" | b"gAMA" | b"sRGB" | b"pHYs" | b"sBIT") {
+            out.extend_from_slice(&bytes[at..end]);
+        }
+        at = end;
+    }
+    out
+}
+
+fn sniff_mime(bytes: &[u8], uri: &str) -> String {
+    if bytes.starts_with(b"\x89PNG") {
+        "image/png".into()
+    } else if bytes.starts_with(&[0xFF, 0xD8]) {
+        "image/jpeg".into()
+    } else if bytes.len() > 12 && &bytes[8..12] == b"WEBP" {
+        "image/webp".into()
+    } else if bytes.starts_with(&[0xAB, b'K', b'T', b'X']) {
+        "image/ktx2".into()
+    } else if uri.to_ascii_lowercase().ends_with(".jpg") || uri.to_ascii_lowercase().ends_with(".jpeg") {
+        "image/jpeg".into()
+    } else {
+        "image/png".into()
+    }
+}
+
+fn uses_unknown_extension(json: &Value) -> bool {
+    json.get("extensionsUsed")
+        .and_then(|e| e.as_array())
+        .map(|list| list.iter().any(|e| !KNOWN_EXTENSIONS.contains(&e.as_str().unwrap_or(""))))
+        .unwrap_or(false)
+}
+
+/// Visits every accessor reference; returns the set of indices seen.
+fn accessor_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
+    let mut seen = BTreeSet::new();
+    let mut visit = |v: &mut Value| visit_index(v, &mut seen, f);
+    for mesh in arr_mut(json, "meshes") {
+        for p in arr_mut(mesh, "primitives") {
+            for a in obj_values_mut(p.get_mut("attributes")) {
+                visit(a);
+            }
+            if let Some(i) = p.get_mut("indices") {
+                visit(i);
+            }
+            for t in arr_mut(p, "targets") {
+                for a in obj_values_mut(Some(t)) {
+                    visit(a);
+                }
+            }
+        }
+    }
+    for skin in arr_mut(json, "skins") {
+        if let Some(i) = skin.get_mut("inverseBindMatrices") {
+            visit(i);
+        }
+    }
+    for anim in arr_mut(json, "animations") {
+        for s in arr_mut(anim, "samplers") {
+            for key in ["input", "output"] {
+                if let Some(i) = s.get_mut(key) {
+                    visit(i);
+                }
+            }
+        }
+    }
+    for node in arr_mut(json, "nodes") {
+        let inst = node.pointer_mut("/extensions/EXT_mesh_gpu_instancing/attributes");
+        for a in obj_values_mut(inst) {
+            visit(a);
+        }
+    }
+    seen
+}
+
+/// Visits every buffer-view reference; returns the set of indices seen.
+fn view_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
+    let mut seen = BTreeSet::new();
+    let mut visit = |v: &mut Value| visit_index(v, &mut seen, f);
+    for a in arr_mut(json, "accessors") {
+        if let Some(v) = a.get_mut("bufferView") {
+            visit(v);
+        }
+        for p in ["/sparse/indices/bufferView", "/sparse/values/bufferView"] {
+            if let Some(v) = a.pointer_mut(p) {
+                visit(v);
+            }
+        }
+    }
+    for img in arr_mut(json, "images") {
+        if let Some(v) = img.get_mut("bufferView") {
+            visit(v);
+        }
+    }
+    for mesh in arr_mut(json, "meshes") {
+        for p in arr_mut(mesh, "primitives") {
+            if let Some(v) = p.pointer_mut("/extensions/KHR_draco_mesh_compression/bufferView") {
+                visit(v);
+            }
+        }
+    }
+    seen
+}
+
+fn visit_index(v: &mut Value, seen: &mut BTreeSet<usize>, f: &mut dyn FnMut(&mut usize)) {
+    if let Some(mut i) = v.as_u64().map(|i| i as usize) {
+        seen.insert(i);
+        f(&mut i);
+        *v = json!(i);
+    }
+}
+
+/// Keeps the listed entries of `json[key]`; returns old index -> new index.
+fn renumber(json: &mut Value, key: &str, keep: &BTreeSet<usize>) -> Vec<Option<usize>> {
+    let list = json.get(key).and_then(|a| a.as_array()).cloned().unwrap_or_default();
+    let mut map = vec![None; list.len().max(keep.iter().next_back().map(|m| m + 1).unwrap_or(0))];
+    let mut kept = Vec::new();
+    for (i, item) in list.into_iter().enumerate() {
+        if keep.contains(&i) {
+            map[i] = Some(kept.len());
+            kept.push(item);
+        }
+    }
+    if json.get(key).is_some() {
+        json[key] = Value::Array(kept);
+    }
+    map
+}
+
+fn arr_mut<'a>(v: &'a mut Value, key: &str) -> std::slice::IterMut<'a, Value> {
+    match v.get_mut(key).and_then(|a| a.as_array_mut()) {
+        Some(a) => a.iter_mut(),
+        None => [].iter_mut(),
+    }
+}
+
+fn obj_values_mut(v: Option<&mut Value>) -> Vec<&mut Value> {
+    match v.and_then(|v| v.as_object_mut()) {
+        Some(o) => o.values_mut().collect(),
+        None => Vec::new(),
+    }
+}

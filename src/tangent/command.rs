@@ -1,0 +1,108 @@
+//! The `tangents` job as a library call: read, generate, write, report.
+
+use super::apply::{apply, ApplyOptions, PrimReport};
+use crate::error::Result;
+use crate::report::Timings;
+use crate::scene::{self, ReadOptions, Scene, WriteOptions, WriteStats};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Default)]
+pub struct TangentsJob {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub read: ReadOptions,
+    pub apply: ApplyOptions,
+    pub write: WriteOptions,
+}
+
+/// Everything the job did; printed as text or JSON by the binary.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct TangentsReport {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub primitives: Vec<PrimReport>,
+    pub generated: usize,
+    pub kept: usize,
+    pub skipped: usize,
+    pub vertices_in: usize,
+    pub vertices_out: usize,
+    pub fallback_frames: usize,
+    pub notes: Vec<String>,
+    pub written: WriteStats,
+    pub timings_ms: Timings,
+}
+
+/// Runs the job. Nothing is written unless every step succeeds.
+pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
+    let mut t = Timings::default();
+    let mut scene = t.time("read", || Scene::read(&job.input, &job.read))?;
+    let prims = t.time("tangents", || apply(&mut scene, &job.apply))?;
+    let (files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
+    t.time("write", || files.commit())?;
+    Ok(summarise(&job.input, &job.output, prims, scene.notes, written, t))
+}
+
+fn summarise(input: &Path, output: &Path, prims: Vec<PrimReport>, notes: Vec<String>, written: WriteStats, t: Timings) -> TangentsReport {
+    let count = |a: &str| prims.iter().filter(|p| p.action == a).count();
+    let stats = prims.iter().filter_map(|p| p.stats.as_ref());
+    TangentsReport {
+        input: input.to_path_buf(),
+        output: output.to_path_buf(),
+        generated: count("generated"),
+        kept: count("kept"),
+        skipped: count("skipped"),
+        vertices_in: stats.clone().map(|s| s.vertices_in).sum(),
+        vertices_out: stats.clone().map(|s| s.vertices_out).sum(),
+        fallback_frames: stats.map(|s| s.fallback.total()).sum(),
+        primitives: prims,
+        notes,
+        written,
+        timings_ms: t,
+    }
+}
+
+impl TangentsReport {
+    /// The human summary.
+    pub fn text(&self) -> String {
+        let mut s = format!(
+            "{} -> {}: {} primitives got tangents, {} kept theirs, {} skipped\n",
+            self.input.display(),
+            self.output.display(),
+            self.generated,
+            self.kept,
+            self.skipped
+        );
+        for p in &self.primitives {
+            let at = format!("  mesh {} primitive {}", p.mesh, p.primitive);
+            match (&p.stats, &p.reason) {
+                (Some(st), _) => {
+                    s += &format!("{at}: TEXCOORD_{} {} tris, vertices {} -> {}", p.uv_set.unwrap_or(0), st.triangles, st.vertices_in, st.vertices_out);
+                    if st.fallback.total() > 0 {
+                        s += &format!(", {} fallback frames ({} undefined, {} invalid)", st.fallback.total(), st.fallback.undefined, st.fallback.invalid);
+                    }
+                    if st.generated_normals {
+                        s += ", flat normals generated (NORMAL was missing)";
+                    }
+                    if let Some(r) = &p.reason {
+                        s += &format!("; {r}");
+                    }
+                    s += "\n";
+                }
+                (None, Some(r)) => s += &format!("{at}: {}: {r}\n", p.action),
+                (None, None) => s += &format!("{at}: {}\n", p.action),
+            }
+        }
+        for n in &self.notes {
+            s += &format!("  note: {n}\n");
+        }
+        if self.written.accessors_dropped > 0 {
+            s += &format!(
+                "  dropped {} unreferenced accessors, {} buffer views ({} -> {} buffer bytes)\n",
+                self.written.accessors_dropped, self.written.buffer_views_dropped, self.written.buffer_bytes_in, self.written.buffer_bytes_out
+            );
+        }
+        let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
+        s += &format!("  time: {}\n", times.join(", "));
+        s
+    }
+}
