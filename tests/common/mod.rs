@@ -148,10 +148,29 @@ impl Gltf {
         self.push_accessor(acc)
     }
 
+    /// A vertex accessor of raw bytes with the given component type.
+    pub fn bytes(&mut self, bytes: &[u8], component_type: u32, ty: &str, count: usize) -> usize {
+        let v = self.view(bytes, Some(34962));
+        self.push_accessor(json!({ "bufferView": v, "componentType": component_type, "count": count, "type": ty }))
+    }
+
     pub fn indices(&mut self, idx: &[u16]) -> usize {
         let bytes: Vec<u8> = idx.iter().flat_map(|i| i.to_le_bytes()).collect();
         let v = self.view(&bytes, Some(34963));
         self.push_accessor(json!({ "bufferView": v, "componentType": 5123, "count": idx.len(), "type": "SCALAR" }))
+    }
+
+    /// Animation inputs need min and max.
+    pub fn accessor_min_max(&mut self, acc: usize) {
+        let a = self.json["accessors"][acc].clone();
+        let view = &self.json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+        let off = view["byteOffset"].as_u64().unwrap() as usize;
+        let n = a["count"].as_u64().unwrap() as usize;
+        let vals: Vec<f32> = (0..n).map(|k| f32::from_le_bytes(self.bin[off + 4 * k..off + 4 * k + 4].try_into().unwrap())).collect();
+        let lo = vals.iter().cloned().fold(f32::INFINITY, f32::min);
+        let hi = vals.iter().cloned().fold(f32::NEG_INFINITY, f32::max);
+        self.json["accessors"][acc]["min"] = json!([lo]);
+        self.json["accessors"][acc]["max"] = json!([hi]);
     }
 
     pub fn push_accessor(&mut self, acc: Value) -> usize {
