@@ -77,3 +77,11 @@ fn write_temp(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
     }
     Ok(tmp)
 }
+
+/// A Make/Ninja depfile: `target: dep dep ...`, spaces in paths escaped.
+pub fn depfile(targets: &[&Path], deps: &[PathBuf]) -> Vec<u8> {
+    let esc = |p: &Path| p.to_string_lossy().replace('\\', "/").replace(' ', "\\ ").replace('#', "\\#").replace('$', "$$");
+    let t: Vec<String> = targets.iter().map(|p| esc(p)).collect();
+    let d: Vec<String> = deps.iter().map(|p| esc(p)).collect();
+    format!("{}: {}\n", t.join(" "), d.join(" \\\n  ")).into_bytes()
+}

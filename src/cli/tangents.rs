@@ -1,23 +1,31 @@
-//! `bumpbake tangents IN -o OUT`.
+//! `bumpbake tangents IN... -o OUT | --out-dir DIR`.
 
+use bumpbake::batch::{self, BatchOptions};
 use bumpbake::scene::{NormalMode, ReadOptions, WriteOptions};
 use bumpbake::tangent::apply::ApplyOptions;
-use bumpbake::tangent::command::{run as run_job, TangentsJob};
+use bumpbake::tangent::command::{run as run_job, TangentsJob, TangentsReport};
 use bumpbake::tangent::Options;
-use bumpbake::Result;
+use bumpbake::{Error, Result};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
-  bumpbake tangents fixtures/spot/spot.obj -o spot.glb
+  bumpbake tangents fixtures/spot/spot.obj -o spot.glb --all
   bumpbake tangents scene.gltf -o scene.gltf --overwrite --bitangents
-  bumpbake tangents model.glb -o out.gltf --embed --json > report.json")]
+  bumpbake tangents assets/*.glb --out-dir build/ -j 4 --json > report.jsonl")]
 pub struct Args {
-    /// Input mesh: .obj (with its .mtl), .gltf or .glb.
-    pub input: PathBuf,
-    /// Output file: .gltf (with a .bin beside it) or .glb.
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// Input meshes: .obj (with its .mtl), .gltf or .glb.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Output file (one input): .gltf (with a .bin beside it) or .glb.
+    #[arg(short, long, conflicts_with = "out_dir")]
+    pub output: Option<PathBuf>,
+    /// Output folder (any number of inputs); names follow the inputs.
+    #[arg(long)]
+    pub out_dir: Option<PathBuf>,
+    /// Extension of the outputs written into --out-dir.
+    #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
+    pub out_ext: String,
     /// Put buffers and images inside a .gltf as data URIs.
     #[arg(long)]
     pub embed: bool,
@@ -36,9 +44,18 @@ pub struct Args {
     /// Let URIs reach outside the input's folder.
     #[arg(long)]
     pub allow_outside: bool,
-    /// Print the report as JSON on stdout.
+    /// Write a Make/Ninja depfile (one input) listing every file read.
+    #[arg(long)]
+    pub depfile: Option<PathBuf>,
+    /// Files processed at once (default: one per core).
+    #[arg(short, long, default_value_t = 0)]
+    pub jobs: usize,
+    /// Print one JSON record per file on stdout (JSON Lines).
     #[arg(long)]
     pub json: bool,
+    /// Show a progress bar even when not on a terminal.
+    #[arg(long)]
+    pub progress: bool,
     /// No report on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -51,9 +68,22 @@ pub enum Normals {
 }
 
 pub fn run(a: Args) -> Result<u8> {
-    let job = TangentsJob {
-        input: a.input,
-        output: a.output,
+    let outputs: Vec<PathBuf> = match (&a.output, &a.out_dir) {
+        (Some(o), None) if a.inputs.len() == 1 => vec![o.clone()],
+        (Some(_), None) => return Err(Error::usage("several inputs need --out-dir, not -o")),
+        (None, Some(d)) => a.inputs.iter().map(|i| batch::derived_output(i, d, &a.out_ext)).collect(),
+        _ => return Err(Error::usage("give -o OUT (one input) or --out-dir DIR")),
+    };
+    batch::unique_outputs(&outputs)?;
+    if a.depfile.is_some() && a.inputs.len() > 1 {
+        return Err(Error::usage("--depfile takes one input"));
+    }
+    if let Some(d) = &a.out_dir {
+        std::fs::create_dir_all(d).map_err(|e| Error::output(d, e))?;
+    }
+    let job = |input: &std::path::Path, output: &std::path::Path| TangentsJob {
+        input: input.to_path_buf(),
+        output: output.to_path_buf(),
         read: ReadOptions {
             allow_outside: a.allow_outside,
             obj_normals: match a.normals {
@@ -63,13 +93,48 @@ pub fn run(a: Args) -> Result<u8> {
         },
         apply: ApplyOptions { all: a.all, overwrite: a.overwrite, frames: Options { bitangents: a.bitangents, ..Default::default() } },
         write: WriteOptions { embed: a.embed },
+        depfile: a.depfile.clone(),
     };
-    let report = run_job(&job)?;
+    let pairs: Vec<(PathBuf, PathBuf)> = a.inputs.iter().cloned().zip(outputs).collect();
+    let inputs: Vec<PathBuf> = pairs.iter().map(|(i, _)| i.clone()).collect();
+    let opts = BatchOptions { jobs: a.jobs, force_progress: a.progress, quiet: a.quiet || a.json };
+    let results = batch::run(&inputs, &opts, |input| {
+        let out = &pairs.iter().find(|(i, _)| i == input).expect("input in batch").1;
+        run_job(&job(input, out))
+    })?;
+    if a.inputs.len() == 1 {
+        // One file: its error is the command's error.
+        let r = results.into_iter().next().expect("one result")?;
+        report(&a, &r);
+        return Ok(0);
+    }
+    let mut failed = Vec::new();
+    for (input, r) in inputs.iter().zip(results) {
+        match r {
+            Ok(rep) => report(&a, &rep),
+            Err(e) => {
+                if a.json {
+                    println!("{}", serde_json::json!({ "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() }));
+                }
+                if !a.quiet {
+                    eprintln!("bumpbake: {e}");
+                }
+                failed.push(input.display().to_string());
+            }
+        }
+    }
+    if !a.quiet {
+        eprintln!("{} files: {} written, {} failed{}", inputs.len(), inputs.len() - failed.len(), failed.len(), if failed.is_empty() { String::new() } else { format!(" ({})", failed.join(", ")) });
+    }
+    Ok(if failed.is_empty() { 0 } else { 2 })
+}
+
+fn report(a: &Args, r: &TangentsReport) {
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report).expect("report serialises"));
+        let mut v = serde_json::to_value(r).expect("report serialises");
+        v["status"] = serde_json::json!("ok");
+        println!("{v}");
+    } else if !a.quiet {
+        eprint!("{}", r.text());
     }
-    if !a.quiet && !a.json {
-        eprint!("{}", report.text());
-    }
-    Ok(0)
 }

@@ -69,6 +69,7 @@ fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value> {
 fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> Result<Scene> {
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mut buffers = Vec::new();
+    let mut deps = Vec::new();
     let mut bin = bin;
     let list = json.get("buffers").and_then(|b| b.as_array()).cloned().unwrap_or_default();
     for (i, b) in list.iter().enumerate() {
@@ -76,7 +77,12 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
             Error::input(path, format!("buffer {i} has no byteLength"))
         })? as usize;
         let data = match b.get("uri").and_then(|u| u.as_str()) {
-            Some(u) => uri::read(u, &base_dir, path, opts.allow_outside)?,
+            Some(u) => {
+                if let uri::Target::File(p) = uri::resolve(u, &base_dir, path, opts.allow_outside)? {
+                    deps.push(p);
+                }
+                uri::read(u, &base_dir, path, opts.allow_outside)?
+            }
             None if i == 0 => bin.take().ok_or_else(|| Error::input(path, "buffer 0 has no uri and there is no GLB binary chunk"))?,
             None => return Err(Error::input(path, format!("buffer {i} has no uri"))),
         };
@@ -93,6 +99,7 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
         allow_outside: opts.allow_outside,
         uv_v_up: false,
         notes: Vec::new(),
+        deps,
         height_maps: Vec::new(),
         own_images: false,
     };

@@ -58,6 +58,8 @@ pub struct Scene {
     pub own_images: bool,
     /// What the reader noticed and the user should hear (e.g. height maps left for `bake`).
     pub notes: Vec<String>,
+    /// Files the reader opened besides `source` (external buffers, MTL files).
+    pub deps: Vec<PathBuf>,
     /// Height maps named by OBJ `bump`/`map_Bump`, which only `bake` can turn into normal maps.
     pub height_maps: Vec<HeightMapRef>,
 }
@@ -128,6 +130,24 @@ impl Scene {
         } else {
             Err(Error::input(path, "unknown mesh format (expected .obj, .gltf or .glb)"))
         }
+    }
+
+    /// Every file the output depends on: the source, external buffers, MTL files, images and
+    /// height maps, for Make/Ninja depfiles.
+    pub fn dependencies(&self) -> Vec<PathBuf> {
+        let mut out = vec![self.source.clone()];
+        out.extend(self.deps.iter().cloned());
+        for img in self.array("images") {
+            if let Some(u) = img.get("uri").and_then(|u| u.as_str()) {
+                if let Ok(uri::Target::File(p)) = uri::resolve(u, &self.base_dir, &self.source, self.allow_outside) {
+                    out.push(p);
+                }
+            }
+        }
+        out.extend(self.height_maps.iter().map(|h| h.path.clone()));
+        let mut seen = std::collections::HashSet::new();
+        out.retain(|p| seen.insert(p.clone()));
+        out
     }
 
     /// An error about this scene's file.

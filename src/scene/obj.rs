@@ -14,9 +14,11 @@ use std::path::Path;
 pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mtl_error: RefCell<Option<Error>> = RefCell::new(None);
+    let mtl_files: RefCell<Vec<std::path::PathBuf>> = RefCell::new(Vec::new());
     let load = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true, ..Default::default() };
     let (models, materials) = tobj::load_obj_buf(&mut BufReader::new(bytes), &load, |mtl: &Path| {
         let name = mtl.to_string_lossy();
+        mtl_files.borrow_mut().push(base_dir.join(mtl));
         match super::uri::read(&name, &base_dir, path, opts.allow_outside) {
             Ok(b) => tobj::load_mtl_buf(&mut BufReader::new(b.as_slice())),
             Err(e) => {
@@ -39,6 +41,7 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
         allow_outside: opts.allow_outside,
         uv_v_up: true,
         notes: Vec::new(),
+        deps: mtl_files.into_inner(),
         height_maps: Vec::new(),
         own_images: true,
     };

@@ -13,6 +13,8 @@ pub struct TangentsJob {
     pub read: ReadOptions,
     pub apply: ApplyOptions,
     pub write: WriteOptions,
+    /// Write a Make/Ninja depfile here.
+    pub depfile: Option<PathBuf>,
 }
 
 /// Everything the job did; printed as text or JSON by the binary.
@@ -37,7 +39,10 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     let mut t = Timings::default();
     let mut scene = t.time("read", || Scene::read(&job.input, &job.read))?;
     let prims = t.time("tangents", || apply(&mut scene, &job.apply))?;
-    let (files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
+    let (mut files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
+    if let Some(d) = &job.depfile {
+        files.add(d, crate::output::depfile(&[&job.output], &scene.dependencies()));
+    }
     t.time("write", || files.commit())?;
     Ok(summarise(&job.input, &job.output, prims, scene.notes, written, t))
 }
