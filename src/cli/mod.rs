@@ -1,6 +1,7 @@
 //! Command-line types (clap derive), one file per subcommand, each with its `run`.
 
 mod bench;
+mod completions;
 mod normalmap;
 mod tangents;
 
@@ -22,6 +23,10 @@ pub enum Command {
     Normalmap(normalmap::Args),
     /// Measure error against run time.
     Bench(bench::Args),
+    /// Print shell completions.
+    Completions(completions::CompletionArgs),
+    /// Print the man page.
+    Man(completions::ManArgs),
 }
 
 /// Runs one parsed command line and returns the process exit code.
@@ -30,5 +35,7 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Completions(a) => completions::completions(a),
+        Command::Man(a) => completions::man(a),
     }
 }
