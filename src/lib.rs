@@ -13,6 +13,7 @@
 
 pub mod batch;
 pub mod error;
+pub mod inspect;
 pub mod normalmap;
 pub mod output;
 pub mod preview;

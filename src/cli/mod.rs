@@ -2,6 +2,7 @@
 
 mod bench;
 mod completions;
+mod inspect;
 mod normalmap;
 mod tangents;
 
@@ -23,6 +24,8 @@ pub enum Command {
     Normalmap(normalmap::Args),
     /// Measure error against run time.
     Bench(bench::Args),
+    /// Show what a mesh file holds: primitives, attributes, materials, tangents, images.
+    Inspect(inspect::Args),
     /// Print shell completions.
     Completions(completions::CompletionArgs),
     /// Print the man page.
@@ -35,6 +38,7 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Inspect(a) => inspect::run(a),
         Command::Completions(a) => completions::completions(a),
         Command::Man(a) => completions::man(a),
     }

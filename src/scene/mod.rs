@@ -150,6 +150,29 @@ impl Scene {
         out
     }
 
+    /// The encoded bytes of image `i` (from its URI, data URI or buffer view).
+    pub fn image_bytes(&self, i: usize) -> Result<Vec<u8>> {
+        let img = self.array("images").get(i).ok_or_else(|| self.err(format!("image {i} does not exist")))?;
+        if let Some(u) = img.get("uri").and_then(|u| u.as_str()) {
+            return uri::read(u, &self.base_dir, &self.source, self.allow_outside);
+        }
+        let v = img.get("bufferView").and_then(as_index).ok_or_else(|| self.err(format!("image {i} has neither uri nor bufferView")))?;
+        let view = self.array("bufferViews").get(v).ok_or_else(|| self.err(format!("image {i}: bufferView {v} does not exist")))?;
+        let b = view.get("buffer").and_then(as_index).unwrap_or(0);
+        let off = view.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+        let len = view.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+        self.buffers
+            .get(b)
+            .and_then(|buf| buf.get(off..off.saturating_add(len)))
+            .map(|s| s.to_vec())
+            .ok_or_else(|| self.err(format!("image {i}: bufferView {v} runs past its buffer")))
+    }
+
+    /// The image index a texture index shows, if any.
+    pub fn texture_image(&self, texture: usize) -> Option<usize> {
+        self.array("textures").get(texture)?.get("source").and_then(as_index)
+    }
+
     /// An error about this scene's file.
     pub fn err(&self, msg: impl Into<String>) -> Error {
         Error::input(&self.source, msg)

@@ -1,0 +1,207 @@
+//! `inspect`: what a file holds that matters for bump mapping: primitives and their attributes,
+//! materials and the textures they use, tangent presence and need, image sizes and bit depths.
+
+use crate::error::Result;
+use crate::scene::{ReadOptions, Scene};
+use crate::tangent::apply::needs_tangents;
+use serde::Serialize;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Inspection {
+    pub file: PathBuf,
+    pub format: &'static str,
+    pub generator: Option<String>,
+    pub nodes: usize,
+    pub meshes: usize,
+    pub animations: usize,
+    pub skins: usize,
+    pub extensions_used: Vec<String>,
+    pub primitives: Vec<PrimInfo>,
+    pub materials: Vec<MaterialInfo>,
+    pub images: Vec<ImageInfo>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct PrimInfo {
+    pub mesh: usize,
+    pub primitive: usize,
+    pub mode: u64,
+    pub material: Option<usize>,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub attributes: Vec<AttrInfo>,
+    pub morph_targets: usize,
+    pub has_tangents: bool,
+    /// The UV set tangents must come from, or why none are needed.
+    pub tangents_needed_from: Option<String>,
+    pub tangents_not_needed: Option<String>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct AttrInfo {
+    pub name: String,
+    pub r#type: String,
+    pub component_type: u32,
+    pub normalized: bool,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct MaterialInfo {
+    pub index: usize,
+    pub name: Option<String>,
+    pub base_color_image: Option<usize>,
+    pub normal_image: Option<usize>,
+    pub normal_tex_coord: Option<u32>,
+    pub normal_scale: Option<f64>,
+    pub height_map: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ImageInfo {
+    pub index: usize,
+    pub stored: &'static str,
+    pub bytes: usize,
+    pub format: Option<String>,
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub color: Option<String>,
+    pub bits_per_channel: Option<u16>,
+    pub error: Option<String>,
+}
+
+pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
+    let scene = Scene::read(path, opts)?;
+    let arr = |k: &str| scene.json.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
+    let mut primitives = Vec::new();
+    for r in scene.primitives() {
+        let pj = scene.prim_json(r).clone();
+        let p = scene.primitive(r)?;
+        let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
+        let need = needs_tangents(&scene, r, false);
+        primitives.push(PrimInfo {
+            mesh: r.mesh,
+            primitive: r.primitive,
+            mode,
+            material: pj.get("material").and_then(|m| m.as_u64()).map(|m| m as usize),
+            vertices: p.vertex_count(),
+            triangles: if mode == 4 { p.indices.len() / 3 } else { p.indices.len().saturating_sub(2) },
+            attributes: p
+                .attributes
+                .iter()
+                .map(|(n, s)| AttrInfo { name: n.clone(), r#type: s.format.ty.clone(), component_type: s.format.component_type, normalized: s.format.normalized })
+                .collect(),
+            morph_targets: p.targets.len(),
+            has_tangents: p.attr("TANGENT").is_some(),
+            tangents_needed_from: need.as_ref().ok().map(|s| format!("TEXCOORD_{s}")),
+            tangents_not_needed: need.err(),
+        });
+    }
+    let materials = arr("materials")
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let tex_image = |v: Option<&Value>| v.and_then(|t| t.get("index")).and_then(|t| t.as_u64()).and_then(|t| scene.texture_image(t as usize));
+            let nt = m.get("normalTexture");
+            MaterialInfo {
+                index: i,
+                name: m.get("name").and_then(|n| n.as_str()).map(String::from),
+                base_color_image: tex_image(m.pointer("/pbrMetallicRoughness/baseColorTexture")),
+                normal_image: tex_image(nt),
+                normal_tex_coord: nt.map(|t| t.get("texCoord").and_then(|c| c.as_u64()).unwrap_or(0) as u32),
+                normal_scale: nt.map(|t| t.get("scale").and_then(|c| c.as_f64()).unwrap_or(1.0)),
+                height_map: scene.height_maps.iter().find(|h| h.material == i).map(|h| h.path.clone()),
+            }
+        })
+        .collect();
+    let images = arr("images").iter().enumerate().map(|(i, img)| image_info(&scene, i, img)).collect();
+    Ok(Inspection {
+        file: path.to_path_buf(),
+        format: if scene.uv_v_up { "obj" } else if std::fs::read(path).map(|b| b.starts_with(b"glTF")).unwrap_or(false) { "glb" } else { "gltf" },
+        generator: scene.json.pointer("/asset/generator").and_then(|g| g.as_str()).map(String::from),
+        nodes: arr("nodes").len(),
+        meshes: arr("meshes").len(),
+        animations: arr("animations").len(),
+        skins: arr("skins").len(),
+        extensions_used: arr("extensionsUsed").iter().filter_map(|e| e.as_str().map(String::from)).collect(),
+        primitives,
+        materials,
+        images,
+    })
+}
+
+fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
+    let stored = match img.get("uri").and_then(|u| u.as_str()) {
+        Some(u) if u.starts_with("data:") => "data-uri",
+        Some(_) => "file",
+        None => "buffer",
+    };
+    let mut info = ImageInfo { index: i, stored, bytes: 0, format: None, width: None, height: None, color: None, bits_per_channel: None, error: None };
+    match scene.image_bytes(i) {
+        Ok(bytes) => {
+            info.bytes = bytes.len();
+            // Only the header is read: a file claiming a huge size costs nothing here.
+            use image::ImageDecoder;
+            let reader = image::ImageReader::new(std::io::Cursor::new(&bytes)).with_guessed_format();
+            match reader.map_err(|e| e.to_string()).and_then(|r| {
+                info.format = r.format().map(|f| format!("{f:?}").to_lowercase());
+                r.into_decoder().map_err(|e| e.to_string())
+            }) {
+                Ok(dec) => {
+                    let (w, h) = dec.dimensions();
+                    let ct = dec.color_type();
+                    info.width = Some(w);
+                    info.height = Some(h);
+                    info.color = Some(format!("{ct:?}"));
+                    info.bits_per_channel = Some(ct.bits_per_pixel() / ct.channel_count() as u16);
+                }
+                Err(e) => info.error = Some(e),
+            }
+        }
+        Err(e) => info.error = Some(e.to_string()),
+    }
+    info
+}
+
+impl Inspection {
+    pub fn text(&self) -> String {
+        let mut s = format!("{} ({}): {} nodes, {} meshes, {} animations, {} skins\n", self.file.display(), self.format, self.nodes, self.meshes, self.animations, self.skins);
+        if !self.extensions_used.is_empty() {
+            s += &format!("  extensions: {}\n", self.extensions_used.join(", "));
+        }
+        for p in &self.primitives {
+            let attrs: Vec<String> = p.attributes.iter().map(|a| format!("{} {}", a.name, a.r#type)).collect();
+            s += &format!("  mesh {} primitive {}: {} vertices, {} triangles, material {}\n    attributes: {}\n", p.mesh, p.primitive, p.vertices, p.triangles, p.material.map(|m| m.to_string()).unwrap_or("-".into()), attrs.join(", "));
+            let t = match (&p.tangents_needed_from, p.has_tangents) {
+                (Some(uv), true) => format!("present; needed (normal texture reads {uv})"),
+                (Some(uv), false) => format!("MISSING; needed (normal texture reads {uv})"),
+                (None, true) => format!("present but unused ({})", p.tangents_not_needed.as_deref().unwrap_or("")),
+                (None, false) => format!("none; not needed ({})", p.tangents_not_needed.as_deref().unwrap_or("")),
+            };
+            s += &format!("    tangents: {t}\n");
+        }
+        for m in &self.materials {
+            s += &format!("  material {} {}: ", m.index, m.name.as_deref().unwrap_or(""));
+            let mut parts = Vec::new();
+            if let Some(i) = m.base_color_image {
+                parts.push(format!("base colour image {i}"));
+            }
+            if let Some(i) = m.normal_image {
+                parts.push(format!("normal image {i} (TEXCOORD_{}, scale {})", m.normal_tex_coord.unwrap_or(0), m.normal_scale.unwrap_or(1.0)));
+            }
+            if let Some(h) = &m.height_map {
+                parts.push(format!("height map {}", h.display()));
+            }
+            s += &(if parts.is_empty() { "no textures".to_string() } else { parts.join(", ") } + "\n");
+        }
+        for i in &self.images {
+            match (&i.error, i.width) {
+                (None, Some(w)) => s += &format!("  image {}: {}x{} {} {}-bit {} ({} bytes, {})\n", i.index, w, i.height.unwrap_or(0), i.format.as_deref().unwrap_or("?"), i.bits_per_channel.unwrap_or(0), i.color.as_deref().unwrap_or(""), i.bytes, i.stored),
+                (Some(e), _) => s += &format!("  image {}: unreadable: {e}\n", i.index),
+                _ => s += &format!("  image {}: {} bytes\n", i.index, i.bytes),
+            }
+        }
+        s
+    }
+}
