@@ -92,7 +92,7 @@ pub fn run(a: Args) -> Result<u8> {
             },
         },
         apply: ApplyOptions { all: a.all, overwrite: a.overwrite, frames: Options { bitangents: a.bitangents, ..Default::default() } },
-        write: WriteOptions { embed: a.embed },
+        write: WriteOptions { embed: a.embed, ..Default::default() },
         depfile: a.depfile.clone(),
     };
     let pairs: Vec<(PathBuf, PathBuf)> = a.inputs.iter().cloned().zip(outputs).collect();

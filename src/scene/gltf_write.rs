@@ -41,6 +41,22 @@ const KNOWN_EXTENSIONS: &[&str] = &[
 pub struct WriteOptions {
     /// For `.gltf`: put buffers and images inside the JSON as data URIs.
     pub embed: bool,
+    /// For `.gltf`: write images held in buffers or data URIs as files beside the output.
+    pub images_external: bool,
+}
+
+/// Where an image ends up in the output.
+enum Place {
+    /// As it is (a data URI in a `.gltf`).
+    Keep,
+    /// In the output's buffer.
+    Buffer,
+    /// As a data URI.
+    DataUri,
+    /// Its file copied beside the output under the same relative name.
+    CopyBeside,
+    /// Written beside the output under a new name.
+    NewFile,
 }
 
 /// What the writer did, for the report.
@@ -82,30 +98,57 @@ pub fn write(scene: &Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs,
     accessor_refs(&mut json, &mut |i| *i = acc_map[*i].expect("kept accessor"));
     stats.accessors_dropped = n_acc - acc_keep.len();
 
-    // Images: embed or copy what URIs name, before buffer views are renumbered.
+    // Images: embedded, copied or written out, before buffer views are renumbered.
     let images = json.get("images").and_then(|i| i.as_array()).cloned().unwrap_or_default();
     let mut new_images = Vec::with_capacity(images.len());
     let mut pending_views: Vec<(Vec<u8>, usize)> = Vec::new();
+    let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string();
     for (i, img) in images.iter().enumerate() {
         let mut img = img.clone();
-        if let Some(u) = img.get("uri").and_then(|u| u.as_str()).map(|s| s.to_string()) {
-            let is_data = u.starts_with("data:");
-            if glb || opts.embed || is_data || scene.own_images {
-                let mut bytes = uri::read(&u, &scene.base_dir, &scene.source, scene.allow_outside)?;
+        let u = img.get("uri").and_then(|u| u.as_str()).map(|s| s.to_string());
+        let plain_file = u.as_deref().map(|u| !u.starts_with("data:")).unwrap_or(false) && !scene.own_images;
+        let place = if glb {
+            Place::Buffer
+        } else if opts.embed {
+            Place::DataUri
+        } else if plain_file {
+            Place::CopyBeside
+        } else if opts.images_external {
+            Place::NewFile
+        } else if u.is_some() && !scene.own_images {
+            Place::Keep
+        } else {
+            Place::Buffer
+        };
+        let in_buffer = img.get("bufferView").is_some();
+        match place {
+            Place::Keep => {}
+            Place::Buffer if in_buffer => {}
+            Place::CopyBeside => copy_beside(&mut img, u.as_deref().unwrap_or(""), scene, &out_dir, &mut files)?,
+            Place::Buffer | Place::DataUri | Place::NewFile => {
+                let mut bytes = scene.image_bytes(i)?;
                 if scene.own_images {
                     bytes = strip_png_colour_chunks(bytes);
                 }
-                let mime = img.get("mimeType").and_then(|m| m.as_str()).map(|s| s.to_string()).unwrap_or_else(|| sniff_mime(&bytes, &u));
-                if glb || scene.own_images {
-                    let o = img.as_object_mut().expect("image is an object");
-                    o.remove("uri");
-                    o.insert("mimeType".into(), json!(mime));
-                    pending_views.push((bytes, i));
-                } else if opts.embed {
-                    img["uri"] = json!(format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(&bytes)));
+                let mime = img.get("mimeType").and_then(|m| m.as_str()).map(|s| s.to_string()).unwrap_or_else(|| sniff_mime(&bytes, u.as_deref().unwrap_or("")));
+                let o = img.as_object_mut().ok_or_else(|| scene.err(format!("image {i} is not an object")))?;
+                o.remove("uri");
+                o.remove("bufferView");
+                match place {
+                    Place::Buffer => {
+                        o.insert("mimeType".into(), json!(mime));
+                        pending_views.push((bytes, i));
+                    }
+                    Place::DataUri => {
+                        o.insert("uri".into(), json!(format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(&bytes))));
+                    }
+                    _ => {
+                        let ext = mime.rsplit('/').next().unwrap_or("png").replace("jpeg", "jpg");
+                        let name = format!("{stem}_image{i}.{ext}");
+                        o.insert("uri".into(), json!(name));
+                        files.add(out_dir.join(&name), bytes);
+                    }
                 }
-            } else {
-                copy_beside(&mut img, &u, scene, &out_dir, &mut files)?;
             }
         }
         new_images.push(img);

@@ -168,6 +168,22 @@ impl Scene {
             .ok_or_else(|| self.err(format!("image {i}: bufferView {v} runs past its buffer")))
     }
 
+    /// Adds encoded image bytes (kept in the buffer) as a new image; returns its index.
+    pub fn push_image(&mut self, bytes: &[u8], mime: &str, name: Option<&str>) -> usize {
+        let s = Stream { format: Format { component_type: accessor::UNSIGNED_BYTE, ty: "SCALAR".into(), normalized: false }, data: bytes.to_vec(), template: None };
+        // Reuse the accessor path for the bytes, then keep only its buffer view.
+        let acc = self.push_accessor(&s, None, false);
+        let view = self.json["accessors"][acc]["bufferView"].clone();
+        array_mut(&mut self.json, "accessors").pop();
+        let mut img = json!({ "bufferView": view, "mimeType": mime });
+        if let Some(n) = name {
+            img["name"] = json!(n);
+        }
+        let images = array_mut(&mut self.json, "images");
+        images.push(img);
+        images.len() - 1
+    }
+
     /// The image index a texture index shows, if any.
     pub fn texture_image(&self, texture: usize) -> Option<usize> {
         self.array("textures").get(texture)?.get("source").and_then(as_index)
