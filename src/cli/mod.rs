@@ -4,6 +4,7 @@ mod bench;
 mod completions;
 mod inspect;
 mod normalmap;
+mod report;
 mod tangents;
 
 use bumpbake::Result;

@@ -6,7 +6,7 @@ use bumpbake::tangent::apply::ApplyOptions;
 use bumpbake::tangent::command::{run as run_job, TangentsJob, TangentsReport};
 use bumpbake::tangent::Options;
 use bumpbake::{Error, Result};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
@@ -68,20 +68,11 @@ pub enum Normals {
 }
 
 pub fn run(a: Args) -> Result<u8> {
-    let outputs: Vec<PathBuf> = match (&a.output, &a.out_dir) {
-        (Some(o), None) if a.inputs.len() == 1 => vec![o.clone()],
-        (Some(_), None) => return Err(Error::usage("several inputs need --out-dir, not -o")),
-        (None, Some(d)) => a.inputs.iter().map(|i| batch::derived_output(i, d, &a.out_ext)).collect(),
-        _ => return Err(Error::usage("give -o OUT (one input) or --out-dir DIR")),
-    };
-    batch::unique_outputs(&outputs)?;
     if a.depfile.is_some() && a.inputs.len() > 1 {
         return Err(Error::usage("--depfile takes one input"));
     }
-    if let Some(d) = &a.out_dir {
-        std::fs::create_dir_all(d).map_err(|e| Error::output(d, e))?;
-    }
-    let job = |input: &std::path::Path, output: &std::path::Path| TangentsJob {
+    let outputs = super::report::outputs(&a.inputs, &a.output, &a.out_dir, &a.out_ext)?;
+    let job = |input: &Path, output: &Path| TangentsJob {
         input: input.to_path_buf(),
         output: output.to_path_buf(),
         read: ReadOptions {
@@ -95,46 +86,7 @@ pub fn run(a: Args) -> Result<u8> {
         write: WriteOptions { embed: a.embed, ..Default::default() },
         depfile: a.depfile.clone(),
     };
-    let pairs: Vec<(PathBuf, PathBuf)> = a.inputs.iter().cloned().zip(outputs).collect();
-    let inputs: Vec<PathBuf> = pairs.iter().map(|(i, _)| i.clone()).collect();
     let opts = BatchOptions { jobs: a.jobs, force_progress: a.progress, quiet: a.quiet || a.json };
-    let results = batch::run(&inputs, &opts, |input| {
-        let out = &pairs.iter().find(|(i, _)| i == input).expect("input in batch").1;
-        run_job(&job(input, out))
-    })?;
-    if a.inputs.len() == 1 {
-        // One file: its error is the command's error.
-        let r = results.into_iter().next().expect("one result")?;
-        report(&a, &r);
-        return Ok(0);
-    }
-    let mut failed = Vec::new();
-    for (input, r) in inputs.iter().zip(results) {
-        match r {
-            Ok(rep) => report(&a, &rep),
-            Err(e) => {
-                if a.json {
-                    println!("{}", serde_json::json!({ "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() }));
-                }
-                if !a.quiet {
-                    eprintln!("bumpbake: {e}");
-                }
-                failed.push(input.display().to_string());
-            }
-        }
-    }
-    if !a.quiet {
-        eprintln!("{} files: {} written, {} failed{}", inputs.len(), inputs.len() - failed.len(), failed.len(), if failed.is_empty() { String::new() } else { format!(" ({})", failed.join(", ")) });
-    }
-    Ok(if failed.is_empty() { 0 } else { 2 })
-}
-
-fn report(a: &Args, r: &TangentsReport) {
-    if a.json {
-        let mut v = serde_json::to_value(r).expect("report serialises");
-        v["status"] = serde_json::json!("ok");
-        println!("{v}");
-    } else if !a.quiet {
-        eprint!("{}", r.text());
-    }
+    let results = batch::run(&a.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.inputs, &outputs, input))))?;
+    super::report::print(&a.inputs, results, a.json, a.quiet, TangentsReport::text)
 }

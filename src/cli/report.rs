@@ -1,0 +1,61 @@
+//! Printing per-file results the same way for every command that takes many inputs: a JSON
+//! Lines record per file (`status` ok or error), or text on stderr, and a summary for batches.
+
+use bumpbake::batch;
+use bumpbake::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// Output paths for the inputs: `-o` for one input, or names derived into `--out-dir`.
+pub fn outputs(inputs: &[PathBuf], output: &Option<PathBuf>, out_dir: &Option<PathBuf>, ext: &str) -> Result<Vec<PathBuf>> {
+    let outs: Vec<PathBuf> = match (output, out_dir) {
+        (Some(o), None) if inputs.len() == 1 => vec![o.clone()],
+        (Some(_), None) => return Err(Error::usage("several inputs need --out-dir, not -o")),
+        (None, Some(d)) => {
+            std::fs::create_dir_all(d).map_err(|e| Error::output(d, e))?;
+            inputs.iter().map(|i| batch::derived_output(i, d, ext)).collect()
+        }
+        _ => return Err(Error::usage("give -o OUT (one input) or --out-dir DIR")),
+    };
+    batch::unique_outputs(&outs)?;
+    Ok(outs)
+}
+
+/// Prints every result; returns the exit code. With one input its error is the command's error.
+pub fn print<R: serde::Serialize>(inputs: &[PathBuf], results: Vec<Result<R>>, json: bool, quiet: bool, text: impl Fn(&R) -> String) -> Result<u8> {
+    let single = inputs.len() == 1;
+    let mut failed = Vec::new();
+    for (input, r) in inputs.iter().zip(results) {
+        match r {
+            Ok(rep) if json => {
+                let mut v = serde_json::to_value(&rep).expect("report serialises");
+                v["status"] = serde_json::json!("ok");
+                println!("{v}");
+            }
+            Ok(rep) => {
+                if !quiet {
+                    eprint!("{}", text(&rep));
+                }
+            }
+            Err(e) if single => return Err(e),
+            Err(e) => {
+                if json {
+                    println!("{}", serde_json::json!({ "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() }));
+                }
+                if !quiet {
+                    eprintln!("bumpbake: {e}");
+                }
+                failed.push(input.display().to_string());
+            }
+        }
+    }
+    if !single && !quiet {
+        let which = if failed.is_empty() { String::new() } else { format!(" ({})", failed.join(", ")) };
+        eprintln!("{} files: {} written, {} failed{which}", inputs.len(), inputs.len() - failed.len(), failed.len());
+    }
+    Ok(if failed.is_empty() { 0 } else { 2 })
+}
+
+/// The output paired with `input` in a batch.
+pub fn paired<'a>(inputs: &[PathBuf], outputs: &'a [PathBuf], input: &Path) -> &'a Path {
+    &outputs[inputs.iter().position(|i| i == input).expect("input in batch")]
+}
