@@ -3,7 +3,7 @@
 //! texel by half a degree). Float output stores the same `n·0.5 + 0.5` unrounded, so every
 //! format decodes the same way: `n = 2·texel - 1`.
 
-use super::rows::{self, unit_normal, Progress};
+use super::rows::{self, Progress};
 use super::{Convention, HeightPlane, NormalPlane, Options};
 
 /// Sample type of the encoded map.
@@ -122,61 +122,101 @@ fn channels(enc: &EncodeOptions) -> usize {
 
 /// Runs the filter and encodes in one pass, straight into the output buffer: the whole
 /// `normalmap` command's work between decoding and writing.
-pub fn encode_normals(
-    height: &HeightPlane,
-    opts: &Options,
-    enc: &EncodeOptions,
-    progress: Progress,
-) -> NormalImage {
-    let data = match enc.depth {
-        Depth::Bits8 => NormalData::U8(fused(height, opts, enc, progress, 0u8, quantize8, alpha8)),
-        Depth::Bits16 => NormalData::U16(fused(
-            height, opts, enc, progress, 0u16, quantize16, alpha16,
-        )),
-        Depth::Float => {
-            NormalData::F32(fused(height, opts, enc, progress, 0f32, float_texel, |h| h))
-        }
-    };
-    NormalImage {
-        width: height.width,
-        height: height.height,
-        channels: channels(enc),
-        data,
-    }
+pub fn encode_normals(height: &HeightPlane, opts: &Options, enc: &EncodeOptions, progress: Progress) -> NormalImage {
+    let mut img = NormalImage { width: 0, height: 0, channels: 0, data: NormalData::U8(Vec::new()) };
+    encode_normals_into(height, opts, enc, progress, &mut img);
+    img
 }
 
-/// One monomorphic loop per sample type and channel count, so each vectorises.
-fn fused<T: Copy + Send + Sync>(
+/// [`encode_normals`] into an existing image, reusing its buffer when the sample type matches:
+/// for callers that convert many maps, and for timing the filter without the cost of the
+/// operating system handing over fresh pages.
+pub fn encode_normals_into(
     height: &HeightPlane,
     opts: &Options,
     enc: &EncodeOptions,
     progress: Progress,
-    zero: T,
+    img: &mut NormalImage,
+) {
+    let old = std::mem::replace(&mut img.data, NormalData::U8(Vec::new()));
+    img.data = match (enc.depth, old) {
+        (Depth::Bits8, NormalData::U8(mut v)) => {
+            fused(height, opts, enc, progress, &mut v, quantize8, alpha8);
+            NormalData::U8(v)
+        }
+        (Depth::Bits8, _) => NormalData::U8(fused_new(height, opts, enc, progress, quantize8, alpha8)),
+        (Depth::Bits16, NormalData::U16(mut v)) => {
+            fused(height, opts, enc, progress, &mut v, quantize16, alpha16);
+            NormalData::U16(v)
+        }
+        (Depth::Bits16, _) => NormalData::U16(fused_new(height, opts, enc, progress, quantize16, alpha16)),
+        (Depth::Float, NormalData::F32(mut v)) => {
+            fused(height, opts, enc, progress, &mut v, float_texel, |h| h);
+            NormalData::F32(v)
+        }
+        (Depth::Float, _) => NormalData::F32(fused_new(height, opts, enc, progress, float_texel, |h| h)),
+    };
+    img.width = height.width;
+    img.height = height.height;
+    img.channels = channels(enc);
+}
+
+fn fused_new<T: Copy + Send + Sync + Default>(
+    height: &HeightPlane,
+    opts: &Options,
+    enc: &EncodeOptions,
+    progress: Progress,
     q: impl Fn(f32) -> T + Sync + Copy,
     qa: impl Fn(f32) -> T + Sync + Copy,
 ) -> Vec<T> {
+    let mut v = Vec::new();
+    fused(height, opts, enc, progress, &mut v, q, qa);
+    v
+}
+
+/// Normals go to three float planes first, then to samples plane by plane, then are
+/// interleaved: each step is a simple loop the compiler vectorises, where one fused
+/// interleaved loop stays scalar (measured 1.6x slower).
+fn fused<T: Copy + Send + Sync + Default>(
+    height: &HeightPlane,
+    opts: &Options,
+    enc: &EncodeOptions,
+    progress: Progress,
+    out: &mut Vec<T>,
+    q: impl Fn(f32) -> T + Sync + Copy,
+    qa: impl Fn(f32) -> T + Sync + Copy,
+) {
     let (w, h, ch) = (height.width, height.height, channels(enc));
     let (s, ysign, invert) = (opts.signed_strength(), enc.convention.y_sign(), opts.invert);
-    let mut out = vec![zero; w * h * ch];
-    rows::for_each_row(
-        height,
-        opts,
-        &mut out,
-        w * ch,
-        progress,
-        |y, gx, gy, row| {
-            let normal = |x: usize| unit_normal(gx[x], gy[x], s);
-            if ch == 4 {
-                let hrow = &height.data[y * w..(y + 1) * w];
-                write_row::<_, 4>(row, ysign, normal, q, |x| {
-                    qa(stored_height(hrow[x], invert))
-                });
-            } else {
-                write_row::<_, 3>(row, ysign, normal, q, |_| zero);
+    let zero = T::default();
+    out.resize(w * h * ch, zero);
+    let state = || {
+        let n: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0.0f32; w]);
+        let c: [Vec<T>; 4] = std::array::from_fn(|_| vec![zero; w]);
+        (n, c)
+    };
+    rows::for_each_row(height, opts, out, w * ch, progress, state, |y, x0, gx, gy, row, (n, c)| {
+        let len = gx.len();
+        rows::unit_normals_planar(gx, gy, s, ysign, n);
+        for k in 0..3 {
+            for (o, &v) in c[k][..len].iter_mut().zip(&n[k][..len]) {
+                *o = q(v);
             }
-        },
-    );
-    out
+        }
+        if ch == 4 {
+            let hrow = &height.data[y * w + x0..y * w + x0 + len];
+            for (o, &v) in c[3].iter_mut().zip(hrow) {
+                *o = qa(stored_height(v, invert));
+            }
+            for (x, px) in row.chunks_exact_mut(4).enumerate() {
+                px.copy_from_slice(&[c[0][x], c[1][x], c[2][x], c[3][x]]);
+            }
+        } else {
+            for (x, px) in row.chunks_exact_mut(3).enumerate() {
+                px.copy_from_slice(&[c[0][x], c[1][x], c[2][x]]);
+            }
+        }
+    });
 }
 
 /// Encodes float normals (OpenGL convention, as [`NormalPlane`] holds them). `heights` fills

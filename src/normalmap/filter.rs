@@ -53,10 +53,7 @@ impl RowScratch {
 
 impl<const R: usize> Kernel<R> {
     /// Computes `dh/dx` and `dh/dy_up` for image row `y` of a `width`-wide plane.
-    ///
-    /// `y_up` points to the top of the image, so the derivative across rows takes the row
-    /// above (index `y - 1`) as the positive side.
-    #[inline]
+    #[cfg(test)]
     pub fn row(
         &self,
         plane: &[f32],
@@ -68,6 +65,18 @@ impl<const R: usize> Kernel<R> {
         gx: &mut [f32],
         gy: &mut [f32],
     ) {
+        self.vertical(plane, width, height, wrap, y, scratch);
+        self.horizontal(scratch, 0, &mut gx[..width], &mut gy[..width]);
+    }
+
+    /// First pass for row `y`: the smoothed and the differentiated column sums, padded at both
+    /// ends following the wrap mode, into `scratch`.
+    ///
+    /// `y_up` points to the top of the image, so the derivative across rows takes the row
+    /// above (index `y - 1`) as the positive side: row offset k (downwards) is y_up offset -k,
+    /// so row k is weighted by -D[k] = D[-k].
+    #[inline]
+    pub fn vertical(&self, plane: &[f32], width: usize, height: usize, wrap: Wrap, y: usize, scratch: &mut RowScratch) {
         let rows: [&[f32]; 5] = std::array::from_fn(|j| {
             if j > 2 * R {
                 return &plane[..0];
@@ -77,9 +86,6 @@ impl<const R: usize> Kernel<R> {
         });
         let smooth = &mut scratch.smooth[..width + 2 * R];
         let deriv = &mut scratch.deriv[..width + 2 * R];
-
-        // Vertical pass. Row offset k (downwards) is y_up offset -k, so the derivative across
-        // rows uses -D[k] = D[-k] on row k.
         {
             let (s_out, d_out) = (&mut smooth[R..R + width], &mut deriv[R..R + width]);
             let mid = rows[R];
@@ -88,7 +94,7 @@ impl<const R: usize> Kernel<R> {
                 d_out[x] = 0.0;
             }
             for k in 1..=R {
-                let (up, down) = (rows[R - k], rows[R + k]);
+                let (up, down) = (&rows[R - k][..width], &rows[R + k][..width]);
                 let (sk, dk) = (self.s[R + k], self.d[R + k]);
                 for x in 0..width {
                     s_out[x] += sk * (up[x] + down[x]);
@@ -98,19 +104,25 @@ impl<const R: usize> Kernel<R> {
         }
         pad(smooth, width, R, wrap);
         pad(deriv, width, R, wrap);
+    }
 
-        // Horizontal pass.
-        let gx = &mut gx[..width];
-        let gy = &mut gy[..width];
-        for x in 0..width {
+    /// Second pass: `gx.len()` texels of both derivatives from column `x0` on, from the
+    /// buffers [`Kernel::vertical`] filled. Done in tiles so its outputs stay in L1.
+    #[inline]
+    pub fn horizontal(&self, scratch: &RowScratch, x0: usize, gx: &mut [f32], gy: &mut [f32]) {
+        let n = gx.len();
+        let gy = &mut gy[..n];
+        let (smooth, deriv) = (&scratch.smooth[x0..x0 + n + 2 * R], &scratch.deriv[x0..x0 + n + 2 * R]);
+        let dm = &deriv[R..R + n];
+        for x in 0..n {
             gx[x] = 0.0;
-            gy[x] = self.s[R] * deriv[x + R];
+            gy[x] = self.s[R] * dm[x];
         }
         for k in 1..=R {
             let (sk, dk) = (self.s[R + k], self.d[R + k]);
-            let (sl, sr) = (&smooth[R - k..R - k + width], &smooth[R + k..R + k + width]);
-            let (dl, dr) = (&deriv[R - k..R - k + width], &deriv[R + k..R + k + width]);
-            for x in 0..width {
+            let (sl, sr) = (&smooth[R - k..R - k + n], &smooth[R + k..R + k + n]);
+            let (dl, dr) = (&deriv[R - k..R - k + n], &deriv[R + k..R + k + n]);
+            for x in 0..n {
                 gx[x] += dk * (sr[x] - sl[x]);
                 gy[x] += sk * (dl[x] + dr[x]);
             }

@@ -23,7 +23,7 @@ mod rows;
 mod spectral;
 
 pub use encode::{
-    decode16, decode8, encode_normals, encode_plane, quantize16, quantize8, Depth, EncodeOptions,
+    decode16, decode8, encode_normals, encode_normals_into, encode_plane, quantize16, quantize8, Depth, EncodeOptions,
     NormalData, NormalImage,
 };
 pub use filter::wrap_index;
@@ -177,7 +177,7 @@ pub fn normals_from_height(
     let (w, h) = (height.width, height.height);
     let mut data = vec![[0.0f32; 3]; w * h];
     let s = opts.signed_strength();
-    rows::for_each_row(height, opts, &mut data, w, progress, |_, gx, gy, out| {
+    rows::for_each_row(height, opts, &mut data, w, progress, || (), |_, _, gx, gy, out, _| {
         for ((o, &dx), &dy) in out.iter_mut().zip(gx).zip(gy) {
             *o = unit_normal(dx, dy, s);
         }
