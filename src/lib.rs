@@ -12,6 +12,7 @@
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
 
 pub mod batch;
+pub mod bench;
 pub mod error;
 pub mod inspect;
 pub mod normalmap;

@@ -1,10 +1,162 @@
-//! `bumpbake normalmap`: not built yet.
+//! `bumpbake normalmap HEIGHT -o NORMAL`: parses, checks the numbers, shows progress on a
+//! terminal, and hands the rest to `bumpbake::normalmap::convert_file`.
 
-use bumpbake::Result;
+use bumpbake::normalmap::{
+    self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap,
+};
+use bumpbake::{Error, Result};
+use clap::builder::TypedValueParser;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+/// What alpha holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Alpha {
+    /// The height (after --invert), for parallax mapping.
+    Height,
+}
 
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+#[command(after_help = "Examples:
+  bumpbake normalmap bricks_height.png -o bricks_normal.png --strength 4
+  bumpbake normalmap terrain16.png -o terrain_n.png --bits 16 --height-range 0.05 --texel-size 0.001 --wrap repeat
+  bumpbake normalmap depth.exr -o n.png --invert --convention directx --alpha height --filter spectral")]
+pub struct Args {
+    /// Height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA), TIFF or EXR.
+    pub height: PathBuf,
+    /// Normal map to write: .png (8 or 16-bit), .tif, or .exr (32-bit float).
+    #[arg(short, long, value_name = "NORMAL")]
+    pub output: PathBuf,
+    /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
+    #[arg(long, value_enum, default_value_t = Channel::Luma)]
+    pub channel: Channel,
+    /// S: texels of surface height per unit of height sample (0..1).
+    #[arg(long, allow_negative_numbers = true, conflicts_with_all = ["height_range", "texel_size"])]
+    pub strength: Option<f32>,
+    /// Height of the full 0..1 sample range, in metres (with --texel-size: S = range / texel).
+    #[arg(
+        long,
+        value_name = "METRES",
+        allow_negative_numbers = true,
+        requires = "texel_size"
+    )]
+    pub height_range: Option<f64>,
+    /// Size of one texel, in metres.
+    #[arg(
+        long,
+        value_name = "METRES",
+        allow_negative_numbers = true,
+        requires = "height_range"
+    )]
+    pub texel_size: Option<f64>,
+    /// Derivative filter (all estimate the true slope; see docs/normalmap.md).
+    #[arg(long, value_enum, default_value_t = Filter::default())]
+    pub filter: Filter,
+    /// What lies beyond the edges: repeat for tiling textures.
+    #[arg(long, value_enum, default_value_t = Wrap::Clamp)]
+    pub wrap: Wrap,
+    /// +Y up (opengl, glTF) or down (directx).
+    #[arg(long, value_enum, default_value_t = Convention::Opengl)]
+    pub convention: Convention,
+    /// Bits per PNG/TIFF sample: 8 or 16 (EXR is always float).
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["8", "16"]).map(|s| s.parse::<u8>().unwrap()))]
+    pub bits: Option<u8>,
+    /// Store the height in alpha, for parallax mapping.
+    #[arg(long, value_enum)]
+    pub alpha: Option<Alpha>,
+    /// The input is a depth map (white is deep): use 1 - h.
+    #[arg(long)]
+    pub invert: bool,
+    /// Refuse images whose header claims more pixels than this.
+    #[arg(long, default_value_t = nm::DEFAULT_MAX_PIXELS)]
+    pub max_pixels: u64,
+}
 
-pub fn run(_args: Args) -> Result<u8> {
-    Err(bumpbake::Error::usage("normalmap: not built yet"))
+fn strength(args: &Args) -> Result<f32> {
+    let s = match (args.strength, args.height_range, args.texel_size) {
+        (Some(s), _, _) => s,
+        (None, Some(range), Some(texel)) => {
+            if !(texel.is_finite() && texel > 0.0) {
+                return Err(Error::usage(format!(
+                    "--texel-size {texel}: must be a positive length"
+                )));
+            }
+            if !(range.is_finite() && range >= 0.0) {
+                return Err(Error::usage(format!(
+                    "--height-range {range}: must be zero or a positive length"
+                )));
+            }
+            Options::physical_strength(range, texel)
+        }
+        _ => Options::default().strength,
+    };
+    if !(s.is_finite() && s >= 0.0) {
+        return Err(Error::usage(format!(
+            "strength {s}: must be finite and not negative (use --invert for depth maps)"
+        )));
+    }
+    Ok(s)
+}
+
+pub fn run(args: Args) -> Result<u8> {
+    let format = nm::OutputFormat::from_path(&args.output)?;
+    let depth = format.depth(&args.output, args.bits)?;
+    let options = Options {
+        strength: strength(&args)?,
+        filter: args.filter,
+        wrap: args.wrap,
+        invert: args.invert,
+    };
+    let convert = Convert {
+        input: args.height.clone(),
+        output: args.output.clone(),
+        channel: args.channel,
+        max_pixels: args.max_pixels,
+        options,
+        encode: EncodeOptions {
+            depth,
+            convention: args.convention,
+            alpha_height: args.alpha == Some(Alpha::Height),
+        },
+        png: nm::PngSettings::default(),
+    };
+    let bar = progress_bar(&args);
+    let tick = |rows: usize| bar.inc(rows as u64);
+    let result = nm::convert_file(&convert, Some(&tick));
+    bar.finish_and_clear();
+    result.map(|_| 0)
+}
+
+/// A bar on a terminal for maps big enough to wait for; nothing when piped or under CI.
+fn progress_bar(args: &Args) -> indicatif::ProgressBar {
+    let ci = std::env::var("CI")
+        .map(|v| v == "true" || v == "1")
+        .unwrap_or(false);
+    if ci || !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    // The header is read again by the conversion; this costs microseconds and keeps the
+    // library free of terminal concerns.
+    let rows = image::ImageReader::open(&args.height)
+        .ok()
+        .and_then(|r| r.with_guessed_format().ok())
+        .and_then(|r| r.into_dimensions().ok())
+        .filter(|(w, h)| {
+            (*w as u64) * (*h as u64) >= 4 << 20 && (*w as u64) * (*h as u64) <= args.max_pixels
+        });
+    match rows {
+        Some((_, h)) => {
+            let bar = indicatif::ProgressBar::new(h as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{msg} [{bar:40}] {pos}/{len} rows ({elapsed})",
+                )
+                .unwrap()
+                .progress_chars("=> "),
+            );
+            bar.set_message(format!("normalmap {}", args.height.display()));
+            bar
+        }
+        None => indicatif::ProgressBar::hidden(),
+    }
 }

@@ -1,0 +1,5 @@
+//! Benchmarks that measure error against run time (`bumpbake bench ...`).
+
+pub mod normalmap;
+pub mod plot;
+pub mod surfaces;
