@@ -3,6 +3,7 @@
 mod bench;
 mod normalmap;
 mod tangents;
+mod validate;
 
 use bumpbake::Result;
 use clap::{Parser, Subcommand};
@@ -22,6 +23,7 @@ pub enum Command {
     Normalmap(normalmap::Args),
     /// Measure error against run time.
     Bench(bench::Args),
+    Validate(validate::Args),
 }
 
 /// Runs one parsed command line and returns the process exit code.
@@ -30,5 +32,6 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Validate(a) => validate::run(a),
     }
 }
