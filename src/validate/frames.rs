@@ -133,7 +133,7 @@ pub fn check_w_mixed(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
     let mut worst = Worst::default();
     let tris = d.indices.len() / 3;
     for (k, tri) in d.indices.chunks_exact(3).enumerate() {
-        if tri.iter().any(|&v| ex.bad_vertex[v as usize]) {
+        if tri.iter().any(|&v| ex.bad_vertex[v as usize]) || ex.corner[3 * k..3 * k + 3].iter().any(|&c| c) {
             continue;
         }
         let w = [t[tri[0] as usize][3], t[tri[1] as usize][3], t[tri[2] as usize][3]];

@@ -34,14 +34,18 @@ pub fn text(r: &Report) -> String {
                 }
             }
             if let Some(d) = &sub.convention {
-                out += &format!("  {}: green channel looks {} (confidence {:.2})\n", sub.name, d.convention.describe(), d.confidence);
+                let verdict = if d.confidence >= super::normal_image::REPORT_CONFIDENCE { d.convention.describe() } else { "undetermined" };
+                out += &format!("  {}: green channel {verdict} (confidence {:.2} for {})\n", sub.name, d.confidence, d.convention.describe());
             }
             let mut findings: Vec<&Finding> = sub.findings.iter().collect();
             findings.sort_by(|a, b| b.severity.cmp(&a.severity));
             for f in findings {
                 out += &format!("  {}\n", line(sub, f));
                 for e in &f.examples {
-                    out += &format!("      {} {}: {}\n", e.kind, e.index, e.detail);
+                    match e.at {
+                        Some([x, y]) => out += &format!("      {} ({x}, {y}): {}\n", e.kind, e.detail),
+                        None => out += &format!("      {} {}: {}\n", e.kind, e.index, e.detail),
+                    }
                 }
                 out += &format!("      fix: {}\n", f.hint);
             }

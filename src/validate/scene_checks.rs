@@ -98,12 +98,14 @@ fn check_primitive(d: &PrimData, uses_map: bool, max_angle_deg: f64, from_obj: b
         return;
     }
     frames::check_vectors(d, &mut ex, s);
+    // A shared mirror seam is the root cause of the mixed-w triangles around it: check it first.
+    let expected = (uses_map && has_n && d.uvs.is_some()).then(|| {
+        let e = handedness::expected_w(d, &ex);
+        handedness::check_seams(d, &e, &mut ex, s);
+        e
+    });
     frames::check_w_mixed(d, &mut ex, s);
-    if !(uses_map && has_n && d.uvs.is_some()) {
-        return;
-    }
-    let expected = handedness::expected_w(d, &ex);
-    handedness::check_seams(d, &expected, &mut ex, s);
+    let Some(expected) = expected else { return };
     handedness::check_w_vs_uv(d, &expected, &mut ex, s);
     conformance::check(d, max_angle_deg, &mut ex, s);
 }
