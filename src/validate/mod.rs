@@ -255,11 +255,14 @@ pub fn validate_paths(paths: &[PathBuf], opts: &Options) -> Result<Report> {
 /// Validates one `.gltf`, `.glb`, `.obj`, or a normal-map image.
 pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    let mut rep = if matches!(ext.as_str(), "gltf" | "glb" | "obj") {
+    let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
+    // GLB is known by its magic whatever the name, as `Scene::read` does.
+    let mesh = matches!(ext.as_str(), "gltf" | "glb" | "obj") || bytes.starts_with(b"glTF");
+    let mut rep = if mesh {
+        drop(bytes);
         let scene = Scene::read(path, &opts.read)?;
         FileReport { path: path.to_path_buf(), kind: "mesh", subjects: validate_scene(&scene, opts)? }
     } else {
-        let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
         let img = image::load_from_memory(&bytes).map_err(|e| {
             Error::input(path, format!("neither a mesh (.gltf, .glb, .obj) nor a readable image: {e}"))
         })?;

@@ -32,6 +32,12 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             continue;
         }
         let p = to_triangle_list(scene.primitive(r)?);
+        if p.attr("POSITION").map(|s| s.len()) != Some(p.vertex_count()) {
+            let f = Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", "not checked: no usable POSITION attribute");
+            s.check(Code::PRIMITIVE_NOT_CHECKED, Some(f));
+            subjects.push((s, None));
+            continue;
+        }
         let map_set = scene.normal_texcoord(r);
         let uv_name = format!("TEXCOORD_{}", map_set.unwrap_or(0));
         let d = PrimData {
