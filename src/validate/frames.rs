@@ -154,8 +154,10 @@ pub fn check_w_mixed(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
     }));
 }
 
-/// Zero-area, zero-UV-area and sliver triangles. Marks the first two as having no defined frame.
-pub fn check_degenerate(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
+/// Zero-area, zero-UV-area (when `with_uvs`: the UVs belong to a normal texture) and sliver
+/// triangles. Marks the first two as having no defined frame.
+pub fn check_degenerate(d: &PrimData, with_uvs: bool, ex: &mut Explained, s: &mut Subject) {
+    let uvs = d.uvs.as_ref().filter(|_| with_uvs);
     let tris = d.indices.len() / 3;
     let (mut zero, mut zero_uv, mut sliver) = (0, 0, 0);
     let (mut wz, mut wu, mut ws) = (Worst::default(), Worst::default(), Worst::default());
@@ -177,7 +179,7 @@ pub fn check_degenerate(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
             sliver += 1;
             ws.push(1.0 / quality, || tri_ex(format!("vertices {} {} {}, quality {quality:.2e} (1 = equilateral)", tri[0], tri[1], tri[2])));
         }
-        if let Some(uv) = &d.uvs {
+        if let Some(uv) = uvs {
             let t = [uv[tri[0] as usize], uv[tri[1] as usize], uv[tri[2] as usize]];
             let (a, b) = ([(t[1][0] - t[0][0]) as f64, (t[1][1] - t[0][1]) as f64], [(t[2][0] - t[0][0]) as f64, (t[2][1] - t[0][1]) as f64]);
             let cross = (a[0] * b[1] - a[1] * b[0]).abs();
@@ -192,7 +194,7 @@ pub fn check_degenerate(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
     s.check(Code::TRIANGLE_DEGENERATE, (zero > 0).then(|| {
         Finding::new(Code::TRIANGLE_DEGENERATE, zero, tris, "triangles", format!("{zero} of {tris} triangles have zero area")).examples(wz.into_examples())
     }));
-    if d.uvs.is_some() {
+    if uvs.is_some() {
         s.check(Code::TRIANGLE_UV_DEGENERATE, (zero_uv > 0).then(|| {
             Finding::new(Code::TRIANGLE_UV_DEGENERATE, zero_uv, tris, "triangles", format!("{zero_uv} of {tris} triangles have zero area in the normal map's UV space"))
                 .examples(wu.into_examples())

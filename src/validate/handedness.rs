@@ -28,8 +28,8 @@ pub fn expected_w(d: &PrimData, ex: &Explained) -> Vec<i8> {
         if ex.degenerate_tri[k] {
             continue;
         }
-        let p: Vec<DVec3> = tri.iter().map(|&i| d3(d.positions[i as usize])).collect();
-        let t: Vec<DVec2> = tri.iter().map(|&i| DVec2::new(uv[i as usize][0] as f64, uv[i as usize][1] as f64)).collect();
+        let p = [0, 1, 2].map(|j| d3(d.positions[tri[j] as usize]));
+        let t = [0, 1, 2].map(|j| DVec2::new(uv[tri[j] as usize][0] as f64, uv[tri[j] as usize][1] as f64));
         let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
         let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
         let r = d1.x * d2.y - d2.x * d1.y;

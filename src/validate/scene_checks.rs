@@ -98,8 +98,7 @@ fn check_primitive(d: &PrimData, uses_map: bool, max_angle_deg: f64, from_obj: b
     }
     let mut ex = Explained::new(d.positions.len(), d.indices.len());
     // Degenerate triangles are judged in the UV set that matters: the map's, if there is one.
-    let d_geom = if uses_map { None } else { Some(PrimData { uvs: None, ..d.clone() }) };
-    frames::check_degenerate(d_geom.as_ref().unwrap_or(d), &mut ex, s);
+    frames::check_degenerate(d, uses_map, &mut ex, s);
     if !has_t {
         return;
     }
