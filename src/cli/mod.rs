@@ -6,6 +6,7 @@ mod inspect;
 mod normalmap;
 mod report;
 mod tangents;
+mod validate;
 
 use bumpbake::Result;
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ pub enum Command {
     Normalmap(normalmap::Args),
     /// Measure error against run time.
     Bench(bench::Args),
+    /// Check tangent frames, handedness and normal maps; exit 1 on errors (for CI).
+    Validate(validate::Args),
     /// Show what a mesh file holds: primitives, attributes, materials, tangents, images.
     Inspect(inspect::Args),
     /// Print shell completions.
@@ -39,6 +42,7 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Validate(a) => validate::run(a),
         Command::Inspect(a) => inspect::run(a),
         Command::Completions(a) => completions::completions(a),
         Command::Man(a) => completions::man(a),

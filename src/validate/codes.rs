@@ -1,0 +1,113 @@
+//! The stable check codes, their default severities and fix hints. Codes are part of the
+//! command-line interface (`--deny`, `--allow`) and of the JSON schema: never rename one.
+
+use std::fmt;
+
+/// How bad a finding is. Errors fail the run; warnings fail it with `--strict`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Severity {
+    Info,
+    Warning,
+    Error,
+}
+
+impl Severity {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Info => "info",
+            Severity::Warning => "warning",
+            Severity::Error => "error",
+        }
+    }
+}
+
+macro_rules! codes {
+    ($( $(#[$doc:meta])* $name:ident = $sev:ident, $hint:literal; )*) => {
+        /// A stable check code.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[allow(non_camel_case_types)]
+        pub enum Code { $( $(#[$doc])* $name, )* }
+
+        impl Code {
+            /// Every code, in documentation order.
+            pub const ALL: &'static [Code] = &[ $( Code::$name, )* ];
+            pub fn as_str(self) -> &'static str {
+                match self { $( Code::$name => stringify!($name), )* }
+            }
+            /// The severity a finding has unless `--deny`/`--allow` moves it.
+            pub fn severity(self) -> Severity {
+                match self { $( Code::$name => Severity::$sev, )* }
+            }
+            /// What usually fixes it.
+            pub fn hint(self) -> &'static str {
+                match self { $( Code::$name => $hint, )* }
+            }
+        }
+    };
+}
+
+codes! {
+    /// A normal texture needs a tangent space and the primitive has no TANGENT.
+    TANGENT_MISSING = Warning, "run `bumpbake tangents IN -o OUT`: renderers that derive tangents themselves (many use screen-space derivatives) do not reproduce the frames the map was baked against";
+    /// TANGENT is present but no normal texture reads it.
+    TANGENT_UNUSED = Info, "nothing uses these tangents: leave them out to save memory";
+    /// TANGENT without NORMAL: the glTF spec says to ignore the tangents.
+    TANGENT_WITHOUT_NORMAL = Warning, "export NORMAL too; without it clients compute flat normals and must ignore TANGENT";
+    TANGENT_NOT_FINITE = Error, "regenerate tangents (`bumpbake tangents --overwrite`)";
+    /// Tangent xyz length differs from 1 by more than the Khronos tolerance (0.00674).
+    TANGENT_NOT_UNIT = Error, "normalise the tangents or regenerate them (`bumpbake tangents --overwrite`)";
+    TANGENT_W_INVALID = Error, "w must be exactly +1.0 or -1.0; regenerate tangents (`bumpbake tangents --overwrite`)";
+    /// The three corners of a triangle carry different w: the bitangent flips inside it.
+    TANGENT_W_MIXED = Error, "split the vertices at the mirror seam so each triangle has one w (`bumpbake tangents --overwrite` does)";
+    TANGENT_NOT_ORTHOGONAL = Warning, "orthogonalise tangents against the normals (Gram-Schmidt) or regenerate them";
+    TANGENT_PARALLEL_NORMAL = Error, "the frame is collapsed; regenerate tangents (`bumpbake tangents --overwrite`)";
+    /// w disagrees with the triangle's orientation in the normal texture's UV space.
+    TANGENT_W_MISMATCH_UV = Error, "the bitangent points down the image: flip w, or regenerate tangents (`bumpbake tangents --overwrite`)";
+    /// One vertex serves triangles of both UV orientations (a mirror seam that was not split).
+    TANGENT_SEAM_SHARED = Error, "split the seam vertices so each side gets its own w (`bumpbake tangents --overwrite` does)";
+    /// Stored tangents are further from MikkTSpace's than `--max-angle-deg`.
+    TANGENT_MIKK_ANGLE = Error, "the normal map was baked against MikkTSpace frames the renderer will recompute differently: regenerate tangents with MikkTSpace (`bumpbake tangents --overwrite`) or re-bake the map against these";
+    /// Stored w differs from MikkTSpace's sign on a corner no other check explains.
+    TANGENT_MIKK_SIGN = Error, "regenerate tangents with MikkTSpace (`bumpbake tangents --overwrite`)";
+    TRIANGLE_DEGENERATE = Info, "zero-area triangles have no tangent frame; remove them (weld or decimate) unless they are intentional";
+    /// Zero area in the normal texture's UV space.
+    TRIANGLE_UV_DEGENERATE = Info, "triangles collapsed in UV space get a substitute frame; unwrap them if they are visible";
+    TRIANGLE_SLIVER = Info, "very thin triangles give unstable tangents; consider remeshing them";
+    /// A node shows a mesh through a transform with negative determinant (a mirrored instance).
+    NODE_MIRRORED = Info, "renderers must flip the winding and the bitangent for mirrored instances; check that yours does";
+    /// A primitive the checks cannot read (not triangles, compressed).
+    PRIMITIVE_NOT_CHECKED = Info, "decompress or triangulate the mesh to have it checked";
+    /// The normal texture's image could not be decoded (format, missing file).
+    NORMALMAP_UNREADABLE = Warning, "use PNG (8 or 16 bit) for the normal map, or check that the file exists";
+    /// Texels decode (n = 2*texel - 1) to z < 0: they point into the surface.
+    NORMALMAP_Z_NEGATIVE = Error, "a tangent-space normal map has z >= 0 everywhere (blue >= 128); is this an object-space map or a packed (two-channel) map?";
+    /// Texels decode to vectors far from unit length (|len - 1| > 0.1).
+    NORMALMAP_NOT_UNIT = Warning, "renormalise the map; is this a height map, a packed or a colour-managed (sRGB) image?";
+    /// Every texel is the flat normal (0, 0, 1).
+    NORMALMAP_FLAT = Warning, "the map changes nothing: remove normalTexture or check the bake";
+    /// The green channel follows the other convention than the one expected.
+    NORMALMAP_GREEN_FLIPPED = Error, "invert the green channel (glTF expects OpenGL, +Y up); `bumpbake normalmap` writes either convention";
+}
+
+impl fmt::Display for Code {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::str::FromStr for Code {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let up = s.trim().to_ascii_uppercase();
+        Code::ALL.iter().copied().find(|c| c.as_str() == up).ok_or_else(|| {
+            format!("unknown check code '{s}' (the codes are listed in docs/validate.md and by `bumpbake validate --list-codes`)")
+        })
+    }
+}
+
+impl serde::Serialize for Code {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.as_str())
+    }
+}

@@ -1,0 +1,225 @@
+//! Normal-map images: texels that cannot be tangent-space normals, flat maps, and which way the
+//! green channel runs.
+//!
+//! # The green-channel detector
+//! A normal map made from a height field `h` (conventions: `n = normalize(-S dh/dx, -S dh/dy_up, 1)`)
+//! has `g = (-nx/nz, -ny/nz) = S * grad h`: a gradient field, whose curl
+//! `dg_y/dx - dg_x/dy_up` vanishes. With the green channel flipped (DirectX, `-Y`) the field is
+//! `(S h_x, -S h_y)`, whose curl is `-2 S h_xy`: zero only where the surface has no twist.
+//!
+//! Central differences of central (or Sobel, or any separable) differences commute exactly, so the
+//! residual of a map baked from a height field is quantisation noise alone. The detector sums the
+//! squared curl of the map as it is (`E_as`) and with green negated (`E_flip`): with
+//! `a = dg_y/dx` and `b = dg_x/dy_up` these are `sum (a - b)^2` and `sum (a + b)^2`, so noise adds
+//! equally to both and only the structure tells them apart. The confidence is
+//! `|E_flip - E_as| / (E_flip + E_as)`: 0 when the map cannot tell (flat, separable `f(x) + g(y)`
+//! relief, pure noise, hand-painted detail), near 1 for any height-field bake with twist.
+
+use super::{Code, Example, Finding, Subject, Worst};
+use image::{DynamicImage, Rgb32FImage, RgbImage};
+
+/// Which way a normal map's green channel runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Convention {
+    /// `+Y` up in the image: OpenGL, glTF, Blender.
+    #[value(name = "opengl")]
+    OpenGl,
+    /// `-Y`: DirectX, Unreal, 3ds Max.
+    #[value(name = "directx")]
+    DirectX,
+    /// The map does not say (flat, separable relief, not from a height field).
+    #[value(skip)]
+    Unknown,
+}
+
+impl Convention {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Convention::OpenGl => "OpenGL (+Y)",
+            Convention::DirectX => "DirectX (-Y)",
+            Convention::Unknown => "undetermined",
+        }
+    }
+}
+
+/// The detector's full answer.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Detection {
+    pub convention: Convention,
+    /// 0 (no evidence) to 1 (certain).
+    pub confidence: f64,
+    /// Mean squared curl of the map as it is.
+    pub curl_as_is: f64,
+    /// Mean squared curl with the green channel negated.
+    pub curl_flipped: f64,
+    /// Texels the curl was measured at.
+    pub samples: usize,
+}
+
+/// Confidence from which a map in the other convention is reported.
+pub const REPORT_CONFIDENCE: f64 = 0.5;
+/// Texels whose z is below this cannot give a slope (and are reported as z < 0 or not unit).
+const MIN_Z: f32 = 0.05;
+
+/// Decoded texels of an image, whatever its bit depth.
+pub enum Texels<'a> {
+    Rgb8(&'a RgbImage),
+    RgbF(&'a Rgb32FImage),
+}
+
+impl Texels<'_> {
+    pub fn dimensions(&self) -> (u32, u32) {
+        match self {
+            Texels::Rgb8(i) => i.dimensions(),
+            Texels::RgbF(i) => i.dimensions(),
+        }
+    }
+    /// The texel decoded as the conventions say: `n = 2 * texel - 1`.
+    #[inline]
+    pub fn normal(&self, x: u32, y: u32) -> [f32; 3] {
+        match self {
+            Texels::Rgb8(i) => {
+                let p = i.get_pixel(x, y).0;
+                [p[0] as f32 / 127.5 - 1.0, p[1] as f32 / 127.5 - 1.0, p[2] as f32 / 127.5 - 1.0]
+            }
+            Texels::RgbF(i) => {
+                let p = i.get_pixel(x, y).0;
+                [p[0] * 2.0 - 1.0, p[1] * 2.0 - 1.0, p[2] * 2.0 - 1.0]
+            }
+        }
+    }
+    /// The slope field `(-nx/nz, -ny/nz)`, if the texel has one.
+    #[inline]
+    fn slope(&self, x: u32, y: u32) -> Option<(f64, f64)> {
+        let n = self.normal(x, y);
+        (n[2] > MIN_Z && n.iter().all(|v| v.is_finite())).then(|| ((-n[0] / n[2]) as f64, (-n[1] / n[2]) as f64))
+    }
+}
+
+/// Which convention an 8-bit normal map follows, and how sure the detector is (0..1).
+pub fn detect_convention(img: &RgbImage) -> (Convention, f64) {
+    let d = detect(&Texels::Rgb8(img));
+    (d.convention, d.confidence)
+}
+
+/// The detector on any decoded image (see the module documentation).
+pub fn detect(t: &Texels) -> Detection {
+    let (w, h) = t.dimensions();
+    let (mut e_as, mut e_flip, mut samples) = (0.0f64, 0.0f64, 0usize);
+    if w >= 3 && h >= 3 {
+        for y in 1..h - 1 {
+            for x in 1..w - 1 {
+                let (Some(l), Some(r), Some(up), Some(down)) = (t.slope(x - 1, y), t.slope(x + 1, y), t.slope(x, y - 1), t.slope(x, y + 1)) else {
+                    continue;
+                };
+                // Row index decreases upwards: y - 1 is up.
+                let a = (r.1 - l.1) * 0.5;
+                let b = (up.0 - down.0) * 0.5;
+                e_as += (a - b) * (a - b);
+                e_flip += (a + b) * (a + b);
+                samples += 1;
+            }
+        }
+    }
+    let total = e_as + e_flip;
+    let (convention, confidence) = if samples == 0 || !(total > 1e-12 * samples as f64) || !total.is_finite() {
+        (Convention::Unknown, 0.0)
+    } else {
+        let conf = (e_flip - e_as).abs() / total;
+        (if e_as <= e_flip { Convention::OpenGl } else { Convention::DirectX }, conf)
+    };
+    let per = |e: f64| if samples > 0 { e / samples as f64 } else { 0.0 };
+    Detection { convention, confidence, curl_as_is: per(e_as), curl_flipped: per(e_flip), samples }
+}
+
+/// All checks on one normal-map image; `wanted_by` says who expects `expected`.
+pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut Subject) {
+    let rgb8;
+    let rgbf;
+    let texels = match img {
+        DynamicImage::ImageLuma8(_) | DynamicImage::ImageLumaA8(_) | DynamicImage::ImageRgb8(_) | DynamicImage::ImageRgba8(_) => {
+            rgb8 = img.to_rgb8();
+            Texels::Rgb8(&rgb8)
+        }
+        _ => {
+            rgbf = img.to_rgb32f();
+            Texels::RgbF(&rgbf)
+        }
+    };
+    let (w, h) = texels.dimensions();
+    let total = w as usize * h as usize;
+    let (mut neg, mut nonunit, mut flat) = (0usize, 0usize, 0usize);
+    let (mut w_neg, mut w_nu) = (Worst::default(), Worst::default());
+    for y in 0..h {
+        for x in 0..w {
+            let n = texels.normal(x, y);
+            let texel = |detail: String| Example { kind: "texel", index: y as u64 * w as u64 + x as u64, at: Some([x, y]), detail };
+            if !n.iter().all(|v| v.is_finite()) {
+                nonunit += 1;
+                w_nu.push(f64::INFINITY, || texel(format!("decodes to {n:?}")));
+                continue;
+            }
+            // Half an 8-bit step below zero: 127 is negative, 128 (z = 0 rounded) is not.
+            if n[2] < -0.002 {
+                neg += 1;
+                w_neg.push(-n[2] as f64, || texel(format!("decodes to ({:.3}, {:.3}, {:.3})", n[0], n[1], n[2])));
+                continue;
+            }
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if (len - 1.0).abs() > 0.1 {
+                nonunit += 1;
+                w_nu.push((len - 1.0).abs() as f64, || texel(format!("decodes to ({:.3}, {:.3}, {:.3}), length {len:.3}", n[0], n[1], n[2])));
+            }
+            if n[0].abs() < 0.02 && n[1].abs() < 0.02 && n[2] > 0.98 {
+                flat += 1;
+            }
+        }
+    }
+    s.check(Code::NORMALMAP_Z_NEGATIVE, (neg > 0).then(|| {
+        Finding::new(Code::NORMALMAP_Z_NEGATIVE, neg, total, "texels", format!("{neg} of {total} texels decode to z < 0 (pointing into the surface)"))
+            .examples(w_neg.into_examples())
+    }));
+    s.check(Code::NORMALMAP_NOT_UNIT, (nonunit > 0).then(|| {
+        Finding::new(Code::NORMALMAP_NOT_UNIT, nonunit, total, "texels", format!("{nonunit} of {total} texels decode to vectors more than 10% off unit length"))
+            .examples(w_nu.into_examples())
+    }));
+    let all_flat = total > 0 && flat == total;
+    s.check(Code::NORMALMAP_FLAT, all_flat.then(|| {
+        Finding::new(Code::NORMALMAP_FLAT, total, total, "texels", format!("every texel of this {w}x{h} map is the flat normal (0, 0, 1)"))
+    }));
+    if all_flat {
+        return;
+    }
+    let d = detect(&texels);
+    s.convention = Some(d);
+    s.check(Code::NORMALMAP_GREEN_FLIPPED, green_finding(&d, expected, wanted_by));
+}
+
+fn green_finding(d: &Detection, expected: Convention, wanted_by: &str) -> Option<Finding> {
+    if expected == Convention::Unknown || d.convention == Convention::Unknown || d.convention == expected || d.confidence < REPORT_CONFIDENCE {
+        return None;
+    }
+    let hint = match expected {
+        Convention::OpenGl => Code::NORMALMAP_GREEN_FLIPPED.hint().to_string(),
+        _ => "invert the green channel: this map is OpenGL (+Y up) and DirectX (-Y) is expected".to_string(),
+    };
+    Some(
+        Finding::new(
+            Code::NORMALMAP_GREEN_FLIPPED,
+            d.samples,
+            d.samples,
+            "texels",
+            format!(
+                "looks like {} (confidence {:.2}); {wanted_by} expects {}",
+                d.convention.describe(),
+                d.confidence,
+                expected.describe()
+            ),
+        )
+        .hint(hint)
+        .metric("confidence", d.confidence)
+        .metric("curl_as_is", d.curl_as_is)
+        .metric("curl_flipped", d.curl_flipped),
+    )
+}

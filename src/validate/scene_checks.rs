@@ -1,0 +1,233 @@
+//! Runs the checks over a whole scene: each primitive (presence, frames, handedness,
+//! conformance, degenerate triangles), node transforms, and each normal-map image once.
+
+use super::frames::{self, Explained, PrimData};
+use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
+use crate::error::Result;
+use crate::scene::{PrimRef, Scene};
+use crate::tangent::apply::to_triangle_list;
+use rayon::prelude::*;
+use serde_json::Value;
+use std::collections::BTreeMap;
+
+pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
+    // Reading is cheap and may fail (exit 2); checking is the expensive part and runs in parallel.
+    let mut subjects = Vec::new();
+    for r in scene.primitives() {
+        let mut s = Subject::new("primitive", prim_name(scene, r));
+        s.mesh = Some(r.mesh);
+        s.primitive = Some(r.primitive);
+        let pj = scene.prim_json(r);
+        let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
+        let why = if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
+            Some("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".to_string())
+        } else if !(4..=6).contains(&mode) {
+            Some(format!("not triangles (mode {mode})"))
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            s.check(Code::PRIMITIVE_NOT_CHECKED, Some(Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", format!("not checked: {why}"))));
+            subjects.push((s, None));
+            continue;
+        }
+        let p = to_triangle_list(scene.primitive(r)?);
+        if p.attr("POSITION").map(|s| s.len()) != Some(p.vertex_count()) {
+            let f = Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", "not checked: no usable POSITION attribute");
+            s.check(Code::PRIMITIVE_NOT_CHECKED, Some(f));
+            subjects.push((s, None));
+            continue;
+        }
+        let map_set = scene.normal_texcoord(r);
+        let uv_name = format!("TEXCOORD_{}", map_set.unwrap_or(0));
+        let d = PrimData {
+            positions: p.positions(),
+            normals: p.attr("NORMAL").map(|s| s.to_f32::<3>()),
+            uvs: p.attr(&uv_name).map(|s| s.to_f32::<2>()),
+            tangents: p.attr("TANGENT").map(|s| s.to_f32::<4>()),
+            indices: p.indices,
+            uv_v_up: scene.uv_v_up,
+        };
+        subjects.push((s, Some((d, map_set.is_some()))));
+    }
+    let max_angle = opts.max_angle_deg;
+    let mut done: Vec<Subject> = subjects
+        .into_par_iter()
+        .map(|(mut s, data)| {
+            if let Some((d, uses_map)) = data {
+                check_primitive(&d, uses_map, max_angle, scene.uv_v_up, &mut s);
+            }
+            s
+        })
+        .collect();
+    if let Some(s) = check_nodes(scene) {
+        done.push(s);
+    }
+    done.extend(check_images(scene));
+    Ok(done)
+}
+
+fn prim_name(scene: &Scene, r: PrimRef) -> String {
+    match scene.json.pointer(&format!("/meshes/{}/name", r.mesh)).and_then(|n| n.as_str()) {
+        Some(n) if !n.is_empty() => format!("mesh {} ('{n}') primitive {}", r.mesh, r.primitive),
+        _ => format!("mesh {} primitive {}", r.mesh, r.primitive),
+    }
+}
+
+/// Every check of one primitive, in the order that lets later checks skip what earlier ones
+/// explained.
+fn check_primitive(d: &PrimData, uses_map: bool, max_angle_deg: f64, from_obj: bool, s: &mut Subject) {
+    let has_t = d.tangents.is_some();
+    let has_n = d.normals.is_some();
+    // OBJ cannot store tangents: the renderer that loads it always makes its own.
+    if uses_map && !from_obj {
+        s.check(Code::TANGENT_MISSING, (!has_t).then(|| {
+            Finding::new(Code::TANGENT_MISSING, 1, 1, "primitives", "the material has a normal texture, but the primitive has no TANGENT")
+        }));
+    }
+    if has_t {
+        s.check(Code::TANGENT_UNUSED, (!uses_map).then(|| {
+            Finding::new(Code::TANGENT_UNUSED, 1, 1, "primitives", "TANGENT is present but no normal texture reads it")
+        }));
+        s.check(Code::TANGENT_WITHOUT_NORMAL, (!has_n).then(|| {
+            Finding::new(Code::TANGENT_WITHOUT_NORMAL, 1, 1, "primitives", "TANGENT without NORMAL: clients must compute flat normals and ignore the tangents")
+        }));
+    }
+    if !(uses_map || has_t) {
+        return;
+    }
+    let mut ex = Explained::new(d.positions.len(), d.indices.len());
+    // Degenerate triangles are judged in the UV set that matters: the map's, if there is one.
+    frames::check_degenerate(d, uses_map, &mut ex, s);
+    if !has_t {
+        return;
+    }
+    frames::check_vectors(d, &mut ex, s);
+    // A shared mirror seam is the root cause of the mixed-w triangles around it: check it first.
+    let expected = (uses_map && has_n && d.uvs.is_some()).then(|| {
+        let e = handedness::expected_w(d, &ex);
+        handedness::check_seams(d, &e, &mut ex, s);
+        e
+    });
+    frames::check_w_mixed(d, &mut ex, s);
+    let Some(expected) = expected else { return };
+    handedness::check_w_vs_uv(d, &expected, &mut ex, s);
+    conformance::check(d, max_angle_deg, &mut ex, s);
+}
+
+/// Nodes that show a mesh through a mirroring transform (negative determinant along the path
+/// from the root).
+fn check_nodes(scene: &Scene) -> Option<Subject> {
+    let nodes = scene.json.get("nodes").and_then(|n| n.as_array())?;
+    let n = nodes.len();
+    let mut parent = vec![usize::MAX; n];
+    for (i, node) in nodes.iter().enumerate() {
+        for c in node.get("children").and_then(|c| c.as_array()).into_iter().flatten() {
+            if let Some(c) = c.as_u64().map(|c| c as usize).filter(|&c| c < n && parent[c] == usize::MAX) {
+                parent[c] = i;
+            }
+        }
+    }
+    let local: Vec<i8> = nodes.iter().map(local_det_sign).collect();
+    // World sign, memoised; a cycle (invalid glTF) is cut at the first repeat.
+    let mut world = vec![0i8; n];
+    for start in 0..n {
+        let mut path = Vec::new();
+        let mut at = start;
+        while at != usize::MAX && world[at] == 0 && path.len() <= n {
+            path.push(at);
+            at = parent[at];
+        }
+        let mut sign = if at != usize::MAX && world[at] != 0 { world[at] } else { 1 };
+        for &k in path.iter().rev() {
+            sign *= local[k];
+            world[k] = sign;
+        }
+    }
+    let with_mesh: Vec<usize> = (0..n).filter(|&i| nodes[i].get("mesh").is_some()).collect();
+    if with_mesh.is_empty() {
+        return None;
+    }
+    let mirrored: Vec<usize> = with_mesh.iter().copied().filter(|&i| world[i] < 0).collect();
+    let mut s = Subject::new("file", "node transforms");
+    let mut worst = Worst::default();
+    for &i in &mirrored {
+        worst.push(1.0 / (1.0 + i as f64), || Example {
+            kind: "node",
+            index: i as u64,
+            at: None,
+            detail: format!("node {i}{} shows mesh {} mirrored", nodes[i].get("name").and_then(|x| x.as_str()).map(|x| format!(" ('{x}')")).unwrap_or_default(), nodes[i]["mesh"]),
+        });
+    }
+    let (count, total) = (mirrored.len(), with_mesh.len());
+    s.check(Code::NODE_MIRRORED, (count > 0).then(|| {
+        Finding::new(Code::NODE_MIRRORED, count, total, "nodes", format!("{count} of {total} mesh nodes have a negative-determinant (mirroring) world transform"))
+            .examples(worst.into_examples())
+    }));
+    Some(s)
+}
+
+fn local_det_sign(node: &Value) -> i8 {
+    let num = |v: &Value| v.as_f64().unwrap_or(0.0);
+    let det = if let Some(m) = node.get("matrix").and_then(|m| m.as_array()).filter(|m| m.len() == 16) {
+        let e = |c: usize, r: usize| num(&m[c * 4 + r]);
+        e(0, 0) * (e(1, 1) * e(2, 2) - e(2, 1) * e(1, 2)) - e(1, 0) * (e(0, 1) * e(2, 2) - e(2, 1) * e(0, 2)) + e(2, 0) * (e(0, 1) * e(1, 2) - e(1, 1) * e(0, 2))
+    } else if let Some(sc) = node.get("scale").and_then(|s| s.as_array()).filter(|s| s.len() == 3) {
+        num(&sc[0]) * num(&sc[1]) * num(&sc[2])
+    } else {
+        1.0
+    };
+    if det < 0.0 {
+        -1
+    } else {
+        1
+    }
+}
+
+/// Each image some material uses as its normal texture, checked once.
+fn check_images(scene: &Scene) -> Vec<Subject> {
+    let mut users: BTreeMap<usize, Vec<String>> = BTreeMap::new();
+    for (m, mat) in scene.json.get("materials").and_then(|m| m.as_array()).into_iter().flatten().enumerate() {
+        let Some(tex) = mat.pointer("/normalTexture/index").and_then(|i| i.as_u64()) else { continue };
+        let Some(img) = scene.json.pointer(&format!("/textures/{tex}/source")).and_then(|i| i.as_u64()) else { continue };
+        let name = mat.get("name").and_then(|n| n.as_str()).map(|n| format!("material {m} ('{n}')")).unwrap_or(format!("material {m}"));
+        users.entry(img as usize).or_default().push(name);
+    }
+    users
+        .into_iter()
+        .map(|(i, mats)| {
+            let img_json = scene.json.pointer(&format!("/images/{i}")).cloned().unwrap_or(Value::Null);
+            let label = img_json
+                .get("name")
+                .and_then(|n| n.as_str())
+                .or_else(|| img_json.get("uri").and_then(|u| u.as_str()).filter(|u| !u.starts_with("data:")))
+                .map(|l| format!("image {i} ('{l}')"))
+                .unwrap_or(format!("image {i}"));
+            let mut s = Subject::new("image", label);
+            s.image = Some(i);
+            let wanted_by = format!("{} (glTF normalTexture)", mats.join(", "));
+            match image_bytes(scene, &img_json).and_then(|b| image::load_from_memory(&b).map_err(|e| format!("cannot decode: {e}"))) {
+                Ok(img) => normal_image::check(&img, Convention::OpenGl, &wanted_by, &mut s),
+                Err(e) => s.check(Code::NORMALMAP_UNREADABLE, Some(Finding::new(Code::NORMALMAP_UNREADABLE, 1, 1, "images", format!("normal texture not checked: {e}")))),
+            }
+            s
+        })
+        .collect()
+}
+
+fn image_bytes(scene: &Scene, img: &Value) -> std::result::Result<Vec<u8>, String> {
+    if let Some(uri) = img.get("uri").and_then(|u| u.as_str()) {
+        return crate::scene::uri::read(uri, &scene.base_dir, &scene.source, scene.allow_outside).map_err(|e| e.to_string());
+    }
+    let view = img.get("bufferView").and_then(|v| v.as_u64()).ok_or("the image has neither uri nor bufferView")?;
+    let v = scene.json.pointer(&format!("/bufferViews/{view}")).ok_or(format!("bufferView {view} does not exist"))?;
+    let b = v.get("buffer").and_then(|b| b.as_u64()).unwrap_or(0) as usize;
+    let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    scene
+        .buffers
+        .get(b)
+        .and_then(|buf| buf.get(off..off.checked_add(len)?))
+        .map(|s| s.to_vec())
+        .ok_or(format!("bufferView {view} lies outside its buffer"))
+}
