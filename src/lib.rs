@@ -11,6 +11,7 @@
 //! - [`preview`]: a CPU reference renderer of the course notes' shading model.
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
 
+pub mod bake;
 pub mod batch;
 pub mod bench;
 pub mod error;

@@ -1,0 +1,130 @@
+//! The normal map a material gets: made from a height map with the normalmap command's code, or
+//! taken from a given normal map (turned to glTF's +Y-up convention when it is DirectX).
+
+use crate::error::{Error, Result};
+use crate::normalmap::{self, Channel, Convention, EncodeOptions, Filter, Options, PngSettings, Wrap};
+use crate::scene::Scene;
+use serde_json::Value;
+use std::path::Path;
+
+/// How height maps become normal maps in `bake`.
+#[derive(Debug, Clone, Copy)]
+pub struct HeightSettings {
+    pub strength: f32,
+    pub filter: Filter,
+    pub invert: bool,
+    pub channel: Channel,
+    pub max_pixels: u64,
+    pub sixteen_bit: bool,
+}
+
+impl Default for HeightSettings {
+    fn default() -> Self {
+        HeightSettings { strength: 1.0, filter: Filter::default(), invert: false, channel: Channel::Luma, max_pixels: normalmap::DEFAULT_MAX_PIXELS, sixteen_bit: false }
+    }
+}
+
+/// The wrap mode a material's textures sample with: the sampler of its normal texture, else of
+/// its base colour texture, else glTF's default (repeat). A map's filter must wrap the same way.
+pub fn material_wrap(scene: &Scene, material: usize) -> Wrap {
+    let m = &scene.json["materials"][material];
+    let tex = m.pointer("/normalTexture/index").or_else(|| m.pointer("/pbrMetallicRoughness/baseColorTexture/index")).and_then(|t| t.as_u64());
+    let sampler = tex.and_then(|t| scene.json.pointer(&format!("/textures/{t}/sampler"))).and_then(|s| s.as_u64());
+    let mode = sampler.and_then(|s| scene.json.pointer(&format!("/samplers/{s}/wrapS"))).and_then(|w| w.as_u64()).unwrap_or(10497);
+    match mode {
+        33071 => Wrap::Clamp,
+        33648 => Wrap::Mirror,
+        _ => Wrap::Repeat,
+    }
+}
+
+/// A PNG normal map (glTF convention) from a height map file.
+pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings) -> Result<Vec<u8>> {
+    let plane = normalmap::load_height(path, s.channel, s.max_pixels)?;
+    let opts = Options { strength: s.strength * multiplier, filter: s.filter, wrap, invert: s.invert };
+    let enc = EncodeOptions { depth: if s.sixteen_bit { normalmap::Depth::Bits16 } else { normalmap::Depth::Bits8 }, convention: Convention::Opengl, alpha_height: false };
+    let img = normalmap::encode_normals(&plane, &opts, &enc, None);
+    normalmap::png_bytes(&img, PngSettings::default()).map_err(|e| Error::output(path, e))
+}
+
+/// What bake decided about a given normal map's green channel.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ConventionCheck {
+    pub detected: String,
+    pub confidence: f64,
+    pub converted: bool,
+}
+
+/// A given normal map, in glTF's convention. `declared` is what the user said (`None`: trust the
+/// detector). A declared convention the detector confidently contradicts is refused.
+pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -> Result<(Vec<u8>, ConventionCheck)> {
+    let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
+    let img = normalmap::open_image(path, max_pixels)?;
+    let (detected, confidence) = crate::validate::detect_convention(&img.to_rgb8());
+    let detected_dx = detected == crate::validate::Convention::DirectX;
+    // The same threshold validate reports a flipped green channel at.
+    let confident = confidence >= 0.5 && detected != crate::validate::Convention::Unknown;
+    let is_dx = match declared {
+        Some(Convention::Directx) if confident && !detected_dx => {
+            return Err(Error::input(path, format!("declared DirectX (-Y), but the map looks like OpenGL (+Y) (confidence {confidence:.2})")))
+        }
+        Some(Convention::Opengl) if confident && detected_dx => {
+            return Err(Error::input(path, format!("declared OpenGL (+Y), but the map looks like DirectX (-Y) (confidence {confidence:.2}); pass --convention directx to convert it")))
+        }
+        Some(c) => c == Convention::Directx,
+        None => detected_dx && confident,
+    };
+    let check = ConventionCheck { detected: detected.describe().into(), confidence, converted: is_dx };
+    if !is_dx {
+        return Ok((bytes, check));
+    }
+    // Flip green: n.y -> -n.y is c -> max - c exactly, so nothing else moves.
+    let out = match img {
+        image::DynamicImage::ImageRgb16(mut b) => {
+            b.pixels_mut().for_each(|p| p[1] = u16::MAX - p[1]);
+            encode(image::DynamicImage::ImageRgb16(b))
+        }
+        image::DynamicImage::ImageRgba16(mut b) => {
+            b.pixels_mut().for_each(|p| p[1] = u16::MAX - p[1]);
+            encode(image::DynamicImage::ImageRgba16(b))
+        }
+        image::DynamicImage::ImageRgba8(mut b) => {
+            b.pixels_mut().for_each(|p| p[1] = 255 - p[1]);
+            encode(image::DynamicImage::ImageRgba8(b))
+        }
+        other => {
+            let mut b = other.to_rgb8();
+            b.pixels_mut().for_each(|p| p[1] = 255 - p[1]);
+            encode(image::DynamicImage::ImageRgb8(b))
+        }
+    }
+    .map_err(|e| Error::output(path, e))?;
+    Ok((out, check))
+}
+
+fn encode(img: image::DynamicImage) -> std::result::Result<Vec<u8>, String> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| e.to_string())?;
+    Ok(out.into_inner())
+}
+
+/// Gives material `m` the normal map in `png` (as a new image and texture) from UV set 0,
+/// sampled like its base colour texture.
+pub fn attach(scene: &mut Scene, m: usize, png: &[u8], name: &str) {
+    let img = scene.push_image(png, "image/png", Some(name));
+    let sampler = scene.json["materials"][m].pointer("/pbrMetallicRoughness/baseColorTexture/index").and_then(|t| t.as_u64()).and_then(|t| scene.json.pointer(&format!("/textures/{t}/sampler")).cloned());
+    let mut tex = serde_json::json!({ "source": img });
+    if let Some(s) = sampler {
+        tex["sampler"] = s;
+    }
+    let textures = crate::scene::array_mut(&mut scene.json, "textures");
+    textures.push(tex);
+    let t = textures.len() - 1;
+    let mat = &mut scene.json["materials"][m];
+    let scale = mat.pointer("/normalTexture/scale").cloned();
+    let mut info = serde_json::json!({ "index": t });
+    if let Some(Value::Number(n)) = scale {
+        info["scale"] = Value::Number(n);
+    }
+    mat["normalTexture"] = info;
+}

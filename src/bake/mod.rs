@@ -1,0 +1,202 @@
+//! `bake`: a mesh and a height or normal map to a render-ready glTF in one step. The map is made
+//! (or converted) and attached, tangents are generated where a normal texture now needs them, and
+//! whatever the scene does not need is left out ([`leave_out`]).
+
+pub mod leave_out;
+pub mod maps;
+
+use crate::error::{Error, Result};
+use crate::normalmap::Convention;
+use crate::report::Timings;
+use crate::scene::{self, ReadOptions, Scene, WriteOptions, WriteStats};
+use crate::tangent::apply::{apply, ApplyOptions, PrimReport};
+use leave_out::Removal;
+use maps::{ConventionCheck, HeightSettings};
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Where the normal map comes from.
+#[derive(Debug, Clone, Default)]
+pub enum MapSource {
+    /// The scene's own: MTL height maps are converted, normal textures used as they are.
+    #[default]
+    Scene,
+    Height(PathBuf),
+    Normal(PathBuf),
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct BakeJob {
+    pub mesh: PathBuf,
+    pub output: PathBuf,
+    pub map: MapSource,
+    /// Only this material gets the map.
+    pub material: Option<String>,
+    pub height: HeightSettings,
+    /// What a `--normal` map's green channel is, if the user says.
+    pub normal_convention: Option<Convention>,
+    pub keep_all: bool,
+    pub bitangents: bool,
+    pub read: ReadOptions,
+    pub write: WriteOptions,
+    pub depfile: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MaterialMap {
+    pub material: usize,
+    pub name: Option<String>,
+    /// `height`, `normal` or `existing`.
+    pub source: &'static str,
+    pub file: Option<PathBuf>,
+    pub convention: Option<ConventionCheck>,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct BakeReport {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub maps: Vec<MaterialMap>,
+    pub primitives: Vec<PrimReport>,
+    pub removed: Vec<Removal>,
+    pub removed_bytes: usize,
+    pub written: WriteStats,
+    pub notes: Vec<String>,
+    pub timings_ms: Timings,
+}
+
+pub fn run(job: &BakeJob) -> Result<BakeReport> {
+    let mut t = Timings::default();
+    let mut scene = t.time("read", || Scene::read(&job.mesh, &job.read))?;
+    let mut deps = scene.dependencies();
+    ensure_material(&mut scene);
+    let targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps))?;
+    let prims = t.time("tangents", || apply(&mut scene, &ApplyOptions { frames: crate::tangent::Options { bitangents: job.bitangents, ..Default::default() }, ..Default::default() }))?;
+    let removed = if job.keep_all { Vec::new() } else { t.time("leave-out", || leave_out::leave_out(&mut scene, job.bitangents))? };
+    let (mut files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
+    if let Some(d) = &job.depfile {
+        files.add(d, crate::output::depfile(&[&job.output], &deps));
+    }
+    t.time("write", || files.commit())?;
+    Ok(BakeReport {
+        input: job.mesh.clone(),
+        output: job.output.clone(),
+        maps: targets,
+        primitives: prims,
+        removed_bytes: removed.iter().map(|r| r.bytes).sum(),
+        removed,
+        written,
+        notes: scene.notes.clone(),
+        timings_ms: t,
+    })
+}
+
+/// A scene without materials gets one, so that a map has somewhere to go.
+fn ensure_material(scene: &mut Scene) {
+    if scene.json.get("materials").and_then(|m| m.as_array()).map(|m| !m.is_empty()).unwrap_or(false) {
+        return;
+    }
+    let rs = scene.primitives();
+    scene.json["materials"] = json!([{ "name": "bumpbake", "pbrMetallicRoughness": { "metallicFactor": 0.0 } }]);
+    for r in rs {
+        let pj = &mut scene.json["meshes"][r.mesh]["primitives"][r.primitive];
+        if pj.get("material").is_none() {
+            pj["material"] = json!(0);
+        }
+    }
+}
+
+fn material_names(scene: &Scene) -> Vec<Option<String>> {
+    scene.json.get("materials").and_then(|m| m.as_array()).into_iter().flatten().map(|m| m.get("name").and_then(|n| n.as_str()).map(String::from)).collect()
+}
+
+/// Decides which materials get which map, and attaches them.
+fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Result<Vec<MaterialMap>> {
+    let names = material_names(scene);
+    let chosen: Option<usize> = match &job.material {
+        Some(want) => Some(names.iter().position(|n| n.as_deref() == Some(want.as_str())).ok_or_else(|| {
+            let have: Vec<String> = names.iter().map(|n| n.clone().unwrap_or_else(|| "(unnamed)".into())).collect();
+            Error::usage(format!("{}: no material named '{want}' (have: {})", job.mesh.display(), have.join(", ")))
+        })?),
+        None => None,
+    };
+    let wants_bump = |m: usize| scene.height_maps.iter().any(|h| h.material == m) || scene.json["materials"][m].get("normalTexture").is_some();
+    let targets: Vec<usize> = match (chosen, &job.map) {
+        (Some(m), _) => vec![m],
+        (None, MapSource::Scene) => (0..names.len()).collect(),
+        (None, _) if names.len() == 1 => vec![0],
+        (None, _) => {
+            let t: Vec<usize> = (0..names.len()).filter(|&m| wants_bump(m)).collect();
+            if t.is_empty() {
+                return Err(Error::usage(format!("{}: {} materials and none has a bump map; choose one with --material", job.mesh.display(), names.len())));
+            }
+            t
+        }
+    };
+    let mut out = Vec::new();
+    let mut made: Option<(Vec<u8>, Option<ConventionCheck>)> = None;
+    for m in targets {
+        let name = names[m].clone();
+        let label = format!("{}_normal", name.clone().unwrap_or_else(|| format!("material{m}")));
+        match &job.map {
+            MapSource::Height(p) | MapSource::Normal(p) => {
+                if made.is_none() {
+                    made = Some(match &job.map {
+                        MapSource::Height(_) => (maps::from_height(p, 1.0, maps::material_wrap(scene, m), &job.height)?, None),
+                        _ => {
+                            let (b, c) = maps::from_normal(p, job.normal_convention, job.height.max_pixels)?;
+                            (b, Some(c))
+                        }
+                    });
+                    deps.push(p.clone());
+                }
+                let (png, conv) = made.clone().expect("made above");
+                maps::attach(scene, m, &png, &label);
+                let source = if matches!(job.map, MapSource::Height(_)) { "height" } else { "normal" };
+                out.push(MaterialMap { material: m, name, source, file: Some(p.clone()), convention: conv });
+            }
+            MapSource::Scene => {
+                if let Some(h) = scene.height_maps.iter().find(|h| h.material == m).cloned() {
+                    let png = maps::from_height(&h.path, h.multiplier, maps::material_wrap(scene, m), &job.height)?;
+                    maps::attach(scene, m, &png, &label);
+                    out.push(MaterialMap { material: m, name, source: "height", file: Some(h.path.clone()), convention: None });
+                } else if scene.json["materials"][m].get("normalTexture").is_some() {
+                    out.push(MaterialMap { material: m, name, source: "existing", file: None, convention: None });
+                }
+            }
+        }
+    }
+    if out.is_empty() {
+        scene.notes.push("no material has a height or normal map: nothing to bake (give --height or --normal)".into());
+    }
+    Ok(out)
+}
+
+impl BakeReport {
+    pub fn text(&self) -> String {
+        let mut s = format!("{} -> {}\n", self.input.display(), self.output.display());
+        for m in &self.maps {
+            let from = m.file.as_ref().map(|f| format!(" from {}", f.display())).unwrap_or_default();
+            s += &format!("  material {} {}: {} map{from}", m.material, m.name.as_deref().unwrap_or(""), m.source);
+            if let Some(c) = &m.convention {
+                s += &format!(" (looks {} at {:.2}{})", c.detected, c.confidence, if c.converted { ", converted to OpenGL +Y" } else { "" });
+            }
+            s += "\n";
+        }
+        let gen = self.primitives.iter().filter(|p| p.action == "generated").count();
+        let fb: usize = self.primitives.iter().filter_map(|p| p.stats.as_ref()).map(|s| s.fallback.total()).sum();
+        s += &format!("  tangents: {gen} primitives, {fb} fallback frames\n");
+        for r in &self.removed {
+            s += &format!("  left out {} ({} bytes)\n", r.what, r.bytes);
+        }
+        if !self.removed.is_empty() {
+            s += &format!("  left out {} bytes in all\n", self.removed_bytes);
+        }
+        for n in &self.notes {
+            s += &format!("  note: {n}\n");
+        }
+        let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
+        s += &format!("  time: {}\n", times.join(", "));
+        s
+    }
+}

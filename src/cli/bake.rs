@@ -1,0 +1,124 @@
+//! `bumpbake bake MESH [--height H | --normal N] -o OUT`.
+
+use bumpbake::bake::maps::HeightSettings;
+use bumpbake::bake::{run as run_job, BakeJob, BakeReport, MapSource};
+use bumpbake::batch::{self, BatchOptions};
+use bumpbake::normalmap::{Channel, Convention, Filter};
+use bumpbake::scene::{ReadOptions, WriteOptions};
+use bumpbake::{Error, Result};
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Examples:
+  bumpbake bake fixtures/bake/torus.obj -o torus.glb
+  bumpbake bake scene.gltf --height bumps.png --material Stone --strength 4 -o scene.glb
+  bumpbake bake model.obj --normal normal_dx.png --convention directx -o model.gltf --images external")]
+pub struct Args {
+    /// Meshes: .obj (with its .mtl), .gltf or .glb.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Output (one input): .glb or .gltf.
+    #[arg(short, long, conflicts_with = "out_dir")]
+    pub output: Option<PathBuf>,
+    /// Output folder (any number of inputs).
+    #[arg(long)]
+    pub out_dir: Option<PathBuf>,
+    /// Extension of outputs written into --out-dir.
+    #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
+    pub out_ext: String,
+    /// Height map to convert into the normal map.
+    #[arg(long, conflicts_with = "normal")]
+    pub height: Option<PathBuf>,
+    /// Normal map to attach (a DirectX one is converted to glTF's +Y).
+    #[arg(long)]
+    pub normal: Option<PathBuf>,
+    /// The material that gets the map (default: those with a bump map, or the only one).
+    #[arg(long)]
+    pub material: Option<String>,
+    /// Height-to-normal strength S (texels of height per unit of h).
+    #[arg(long, default_value_t = 1.0, conflicts_with = "height_range")]
+    pub strength: f32,
+    /// Physical units: height of h = 1, in metres (with --texel-size).
+    #[arg(long, requires = "texel_size")]
+    pub height_range: Option<f32>,
+    /// Physical units: size of one texel, in metres.
+    #[arg(long, requires = "height_range")]
+    pub texel_size: Option<f32>,
+    /// Derivative filter for height maps.
+    #[arg(long, value_enum, default_value_t = Filter::default())]
+    pub filter: Filter,
+    /// Height channel of colour images.
+    #[arg(long, value_enum, default_value_t = Channel::Luma)]
+    pub channel: Channel,
+    /// The height map holds depth.
+    #[arg(long)]
+    pub invert: bool,
+    /// Write 16-bit normal maps.
+    #[arg(long)]
+    pub bits16: bool,
+    /// Green-channel convention of --normal (default: detect it).
+    #[arg(long, value_enum)]
+    pub convention: Option<Convention>,
+    /// Keep everything, even what nothing uses.
+    #[arg(long)]
+    pub keep_all: bool,
+    /// Also write _BITANGENT.
+    #[arg(long)]
+    pub bitangents: bool,
+    /// Images inside the output (GLB, or .gltf's buffer) or as files beside a .gltf.
+    #[arg(long, value_parser = ["embed", "external"], default_value = "embed")]
+    pub images: String,
+    /// Let URIs reach outside the input's folder.
+    #[arg(long)]
+    pub allow_outside: bool,
+    /// Write a Make/Ninja depfile listing every input read (one input).
+    #[arg(long)]
+    pub depfile: Option<PathBuf>,
+    /// Files processed at once (default: one per core).
+    #[arg(short, long, default_value_t = 0)]
+    pub jobs: usize,
+    /// One JSON record per file on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Show a progress bar even when not on a terminal.
+    #[arg(long)]
+    pub progress: bool,
+    /// No report on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: Args) -> Result<u8> {
+    if a.depfile.is_some() && a.inputs.len() > 1 {
+        return Err(Error::usage("--depfile takes one input"));
+    }
+    let outputs = super::report::outputs(&a.inputs, &a.output, &a.out_dir, &a.out_ext)?;
+    let strength = match (a.height_range, a.texel_size) {
+        (Some(r), Some(t)) if t > 0.0 && r.is_finite() && t.is_finite() => r / t,
+        (Some(_), Some(_)) => return Err(Error::usage("--texel-size must be a positive number")),
+        _ => a.strength,
+    };
+    if !strength.is_finite() {
+        return Err(Error::usage("--strength must be finite"));
+    }
+    let job = |input: &Path, output: &Path| BakeJob {
+        mesh: input.to_path_buf(),
+        output: output.to_path_buf(),
+        map: match (&a.height, &a.normal) {
+            (Some(h), _) => MapSource::Height(h.clone()),
+            (None, Some(n)) => MapSource::Normal(n.clone()),
+            _ => MapSource::Scene,
+        },
+        material: a.material.clone(),
+        height: HeightSettings { strength, filter: a.filter, invert: a.invert, channel: a.channel, sixteen_bit: a.bits16, ..Default::default() },
+        normal_convention: a.convention,
+        keep_all: a.keep_all,
+        bitangents: a.bitangents,
+        read: ReadOptions { allow_outside: a.allow_outside, ..Default::default() },
+        write: WriteOptions { images_external: a.images == "external", ..Default::default() },
+        depfile: a.depfile.clone(),
+    };
+    let opts = BatchOptions { jobs: a.jobs, force_progress: a.progress, quiet: a.quiet || a.json };
+    let results = batch::run(&a.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.inputs, &outputs, input))))?;
+    super::report::print(&a.inputs, results, a.json, a.quiet, BakeReport::text)
+}
