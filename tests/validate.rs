@@ -395,7 +395,8 @@ fn undecodable_normal_texture_is_a_warning() {
 #[test]
 fn green_channel_convention_on_height_fields() {
     use bumpbake::validate::{detect_convention, Convention};
-    let fields: Vec<(&str, Box<dyn Fn(f64, f64) -> f64>)> = vec![
+    type Field = Box<dyn Fn(f64, f64) -> f64>;
+    let fields: Vec<(&str, Field)> = vec![
         ("sine product", Box::new(|x, y| 6.0 * (x / 7.0).sin() * (y / 5.0).cos())),
         ("gaussian bump", Box::new(|x, y| 20.0 * (-((x - 40.0).powi(2) + (y - 25.0).powi(2)) / 200.0).exp())),
         ("ripple", Box::new(|x, y| 3.0 * (((x - 32.0).powi(2) + (y - 32.0).powi(2)).sqrt() / 3.0).sin())),

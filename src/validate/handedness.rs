@@ -45,7 +45,7 @@ pub fn expected_w(d: &PrimData, ex: &Explained) -> Vec<i8> {
             let n = d3(normals[v as usize]);
             let b = n.cross(dpdu);
             let denom = b.length() * up.length();
-            if !(denom > 0.0) || !denom.is_finite() {
+            if denom.is_nan() || denom <= 0.0 || !denom.is_finite() {
                 continue;
             }
             let cos = b.dot(up) / denom;

@@ -123,7 +123,7 @@ pub fn detect(t: &Texels) -> Detection {
         }
     }
     let total = e_as + e_flip;
-    let (convention, confidence) = if samples == 0 || !(total > 1e-12 * samples as f64) || !total.is_finite() {
+    let (convention, confidence) = if samples == 0 || total.is_nan() || total <= 1e-12 * samples as f64 || !total.is_finite() {
         (Convention::Unknown, 0.0)
     } else {
         let conf = (e_flip - e_as).abs() / total;
@@ -222,4 +222,41 @@ fn green_finding(d: &Detection, expected: Convention, wanted_by: &str) -> Option
         .metric("curl_as_is", d.curl_as_is)
         .metric("curl_flipped", d.curl_flipped),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A saddle `h = x * y_up / k` baked with central differences, as 8-bit or float texels.
+    fn saddle(directx: bool) -> Rgb32FImage {
+        Rgb32FImage::from_fn(16, 16, |x, row| {
+            let y = 15.0 - row as f32;
+            let (hx, hy) = (y / 8.0, x as f32 / 8.0);
+            let l = (hx * hx + hy * hy + 1.0).sqrt();
+            let ny = if directx { hy / l } else { -hy / l };
+            image::Rgb([(-hx / l) * 0.5 + 0.5, ny * 0.5 + 0.5, (1.0 / l) * 0.5 + 0.5])
+        })
+    }
+
+    #[test]
+    fn float_texels_of_a_saddle() {
+        let gl = detect(&Texels::RgbF(&saddle(false)));
+        assert_eq!(gl.convention, Convention::OpenGl);
+        assert!(gl.confidence > 0.99, "{gl:?}");
+        let dx = detect(&Texels::RgbF(&saddle(true)));
+        assert_eq!(dx.convention, Convention::DirectX);
+        assert!(dx.confidence > 0.99, "{dx:?}");
+    }
+
+    #[test]
+    fn flat_tiny_and_vertical_maps_are_unknown() {
+        let flat = RgbImage::from_pixel(8, 8, image::Rgb([128, 128, 255]));
+        assert_eq!(detect_convention(&flat), (Convention::Unknown, 0.0));
+        let tiny = RgbImage::from_pixel(2, 2, image::Rgb([200, 10, 255]));
+        assert_eq!(detect_convention(&tiny), (Convention::Unknown, 0.0));
+        // z <= 0 everywhere: no slopes to measure.
+        let down = RgbImage::from_pixel(8, 8, image::Rgb([128, 128, 0]));
+        assert_eq!(detect_convention(&down), (Convention::Unknown, 0.0));
+    }
 }

@@ -34,11 +34,11 @@ pub fn text(r: &Report) -> String {
                 }
             }
             if let Some(d) = &sub.convention {
-                let verdict = if d.confidence >= super::normal_image::REPORT_CONFIDENCE { d.convention.describe() } else { "undetermined" };
-                out += &format!("  {}: green channel {verdict} (confidence {:.2} for {})\n", sub.name, d.confidence, d.convention.describe());
+                let verdict = if d.confidence >= super::normal_image::REPORT_CONFIDENCE { format!("looks {}", d.convention.describe()) } else { "undetermined".into() };
+                out += &format!("  {}: green channel {verdict} (confidence {:.2})\n", sub.name, d.confidence);
             }
             let mut findings: Vec<&Finding> = sub.findings.iter().collect();
-            findings.sort_by(|a, b| b.severity.cmp(&a.severity));
+            findings.sort_by_key(|f| std::cmp::Reverse(f.severity));
             for f in findings {
                 out += &format!("  {}\n", line(sub, f));
                 for e in &f.examples {
