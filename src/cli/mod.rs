@@ -2,6 +2,7 @@
 
 mod bench;
 mod normalmap;
+mod preview;
 mod tangents;
 
 use bumpbake::Result;
@@ -22,6 +23,7 @@ pub enum Command {
     Normalmap(normalmap::Args),
     /// Measure error against run time.
     Bench(bench::Args),
+    Preview(preview::Args),
 }
 
 /// Runs one parsed command line and returns the process exit code.
@@ -30,5 +32,6 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Preview(a) => preview::run(a),
     }
 }
