@@ -184,19 +184,24 @@ pub fn run(a: Args) -> Result<u8> {
     }
     let input = a.input.as_ref().ok_or_else(|| Error::usage("preview: no input file"))?;
     let scene = read(input, a.allow_outside)?;
-    let prep = Prepared::new(&scene)?;
+    let t_read = start.elapsed().as_secs_f64() * 1e3;
+    let prep = Prepared::with_frames(&scene, matches!(opts.view, View::Tangent | View::Bitangent | View::Handedness))?;
+    let t_prep = start.elapsed().as_secs_f64() * 1e3;
     let cam = Camera::framed(prep.bounds, &opts.camera, opts.width, opts.height);
     let frame = render(&prep, &cam, &opts);
+    let t_render = start.elapsed().as_secs_f64() * 1e3;
     write_atomic(&a.output, &frame.to_png())?;
     let ms = start.elapsed().as_secs_f64() * 1e3;
+    let stages = serde_json::json!({ "read_ms": t_read, "prepare_ms": t_prep - t_read, "render_ms": t_render - t_prep, "write_ms": ms - t_render });
     if a.json {
         let j = serde_json::json!({
             "input": input, "output": a.output, "view": opts.view.name(), "width": opts.width, "height": opts.height,
-            "ssaa": opts.ssaa, "triangles": prep.triangle_count(), "notes": prep.notes, "time_ms": ms,
+            "ssaa": opts.ssaa, "triangles": prep.triangle_count(), "notes": prep.notes, "time_ms": ms, "stages": stages,
         });
         println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
     } else if !a.quiet {
         eprintln!("preview: {} -> {} ({}x{}, {} view, {} triangles, {:.0} ms)", input.display(), a.output.display(), opts.width, opts.height, opts.view.name(), prep.triangle_count(), ms);
+        eprintln!("  read {:.0} ms, prepare {:.0} ms, render {:.0} ms, write {:.0} ms", t_read, t_prep - t_read, t_render - t_prep, ms - t_render);
         for n in &prep.notes {
             eprintln!("  note: {n}");
         }

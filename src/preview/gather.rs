@@ -70,8 +70,17 @@ pub struct Prepared {
 impl Prepared {
     /// Reads every triangle primitive the scene shows (its default scene's node trees, or every
     /// mesh when there are no nodes). Fails on a scene with nothing to draw.
+    ///
+    /// Primitives without TANGENT get MikkTSpace tangents only where a normal map needs them:
+    /// without a map any frame lights the same, and generating frames costs more than drawing.
     pub fn new(scene: &Scene) -> Result<Prepared> {
-        let mut cx = Cx { scene, textures: HashMap::new(), materials: Vec::new(), material_index: HashMap::new(), notes: Vec::new() };
+        Prepared::with_frames(scene, false)
+    }
+
+    /// [`Prepared::new`], and `all_frames` also generates MikkTSpace tangents for primitives
+    /// whose material has no normal map (for the tangent, bitangent and handedness views).
+    pub fn with_frames(scene: &Scene, all_frames: bool) -> Result<Prepared> {
+        let mut cx = Cx { scene, all_frames, textures: HashMap::new(), materials: Vec::new(), material_index: HashMap::new(), notes: Vec::new() };
         let mut draws = Vec::new();
         let mut prim_cache: HashMap<PrimRef, Option<Local>> = HashMap::new();
         for (mesh, world) in instances(scene) {
@@ -124,6 +133,7 @@ struct Local {
 
 struct Cx<'a> {
     scene: &'a Scene,
+    all_frames: bool,
     textures: HashMap<(usize, bool), Arc<Texture>>,
     materials: Vec<Material>,
     material_index: HashMap<Option<usize>, usize>,
@@ -146,11 +156,12 @@ impl Cx<'_> {
         let uv_set = s.normal_texcoord(r).unwrap_or(0);
         let uv_name = format!("TEXCOORD_{uv_set}");
         let tangents_ok = prim.attr("TANGENT").map(|t| t.format.components() == 4).unwrap_or(false);
-        if !tangents_ok && prim.attr(&uv_name).is_some() && prim.indices.len() >= 3 {
+        let has_map = s.material_of(r).and_then(|m| m.get("normalTexture")).is_some();
+        if !tangents_ok && (has_map || self.all_frames) && prim.attr(&uv_name).is_some() && prim.indices.len() >= 3 {
             prim.indices.truncate(prim.indices.len() / 3 * 3);
             // Exactly what `bumpbake tangents` would store, so the preview shows the tool's frames.
             prim = crate::tangent::primitive_with_tangents(&prim, uv_set, s.uv_v_up, &Default::default());
-            if s.material_of(r).and_then(|m| m.get("normalTexture")).is_some() {
+            if has_map {
                 self.notes.push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));
             }
         }
