@@ -6,6 +6,7 @@ mod completions;
 mod inspect;
 mod normalmap;
 mod report;
+mod preview;
 mod tangents;
 mod validate;
 
@@ -37,6 +38,8 @@ pub enum Command {
     Completions(completions::CompletionArgs),
     /// Print the man page.
     Man(completions::ManArgs),
+    /// Render an asset with the course notes' bump-mapping model (CPU), or compare two.
+    Preview(preview::Args),
 }
 
 /// Runs one parsed command line and returns the process exit code.
@@ -50,5 +53,6 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::Inspect(a) => inspect::run(a),
         Command::Completions(a) => completions::completions(a),
         Command::Man(a) => completions::man(a),
+        Command::Preview(a) => preview::run(a),
     }
 }

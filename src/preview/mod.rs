@@ -1,1 +1,170 @@
-//! CPU reference renderer (issue: preview). Not built yet.
+//! A CPU reference renderer of the course notes' bump-mapping model, so that "ready for any
+//! bump-mapping renderer" can be shown, and measured, without a GPU.
+//!
+//! Use: [`Prepared::new`] once per scene (normals, tangents, textures settled), a [`Camera`]
+//! ([`Camera::framed`] on [`Prepared::bounds`]), then [`render`] as many views as needed.
+//! [`render_scene`] does all three for the common case; [`compare::compare`] measures one scene
+//! against another from the same camera.
+//!
+//! - [`camera`]: perspective camera framed on the bounds.
+//! - [`gather`]: scene to world-space draws and materials.
+//! - [`raster`]: visibility (tiles, depth buffer, perspective-correct barycentrics).
+//! - [`texture`]: decoding and sampling with glTF's wrap modes.
+//! - [`shade`]: the seeds' model (tangent-space lighting, Blinn-Phong, lights).
+//! - [`views`]: the debug views.
+//! - [`compare`]: pipeline error between two renders.
+
+pub mod camera;
+pub mod compare;
+pub mod gather;
+pub mod raster;
+pub mod shade;
+pub mod texture;
+pub mod views;
+
+pub use camera::{Camera, CameraSpec};
+pub use gather::Prepared;
+pub use shade::{Light, Params};
+pub use views::View;
+
+use crate::scene::Scene;
+use crate::Result;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// How to render.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel along each axis (box-filtered).
+    pub ssaa: u32,
+    pub camera: CameraSpec,
+    /// Empty: the camera-relative default rig ([`shade::default_lights`]).
+    pub lights: Vec<Light>,
+    pub view: View,
+    pub params: Params,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { width: 512, height: 512, ssaa: 1, camera: CameraSpec::default(), lights: Vec::new(), view: View::Shaded, params: Params::default() }
+    }
+}
+
+/// Largest number of samples one render may hold (memory stays around 2 GB at worst).
+pub const MAX_SAMPLES: u64 = 1 << 26;
+
+impl Options {
+    /// Checks sizes before any memory is committed to them.
+    pub fn check(&self) -> Result<()> {
+        if self.width == 0 || self.height == 0 || self.ssaa == 0 || self.ssaa > 8 {
+            return Err(crate::Error::usage("preview: size must be at least 1x1 and --ssaa between 1 and 8"));
+        }
+        let n = self.width as u64 * self.height as u64 * (self.ssaa as u64).pow(2);
+        if n > MAX_SAMPLES {
+            return Err(crate::Error::usage(format!("preview: {}x{} with --ssaa {} is {n} samples; the limit is {MAX_SAMPLES}", self.width, self.height, self.ssaa)));
+        }
+        Ok(())
+    }
+}
+
+/// A rendered image and what each pixel saw.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// Display values in `[0, 1]` (sRGB-encoded for the lit views), row-major from the top.
+    pub rgb: Vec<[f32; 3]>,
+    /// Mean world-space shading normal of the covered samples (zero where none).
+    pub normal: Vec<Vec3>,
+    /// Fraction of the pixel's samples that hit a surface.
+    pub coverage: Vec<f32>,
+    /// Mean view depth of the covered samples (infinite where none).
+    pub depth: Vec<f32>,
+}
+
+impl Frame {
+    /// 8-bit RGB, rounded.
+    pub fn to_rgb8(&self) -> image::RgbImage {
+        let mut img = image::RgbImage::new(self.width, self.height);
+        for (p, c) in img.pixels_mut().zip(&self.rgb) {
+            *p = image::Rgb(c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8));
+        }
+        img
+    }
+
+    /// PNG bytes.
+    pub fn to_png(&self) -> Vec<u8> {
+        let mut out = std::io::Cursor::new(Vec::new());
+        // Encoding an in-memory RGB8 image cannot fail short of running out of memory.
+        let _ = self.to_rgb8().write_to(&mut out, image::ImageFormat::Png);
+        out.into_inner()
+    }
+}
+
+/// Frames the camera on the scene and renders it.
+pub fn render_scene(scene: &Scene, opts: &Options) -> Result<Frame> {
+    opts.check()?;
+    let prep = Prepared::new(scene)?;
+    let cam = Camera::framed(prep.bounds, &opts.camera, opts.width, opts.height);
+    Ok(render(&prep, &cam, opts))
+}
+
+/// Renders a prepared scene from `cam` (its width and height are ignored in favour of `opts`').
+pub fn render(prep: &Prepared, cam: &Camera, opts: &Options) -> Frame {
+    let ss = opts.ssaa.clamp(1, 8);
+    let (sw, sh) = (opts.width * ss, opts.height * ss);
+    let lights = if opts.lights.is_empty() { shade::default_lights(cam.eye, cam.target) } else { opts.lights.clone() };
+    let r = raster::rasterise(&prep.draws, &prep.materials, cam, sw, sh);
+    let default_material = gather::Material::default();
+
+    // Shade and resolve one output row at a time: its `ss` sample rows are independent of all
+    // others, so rows run in parallel and the result does not depend on scheduling.
+    let rows: Vec<Vec<(Vec3, Vec3, f32, f32)>> = (0..opts.height)
+        .into_par_iter()
+        .map(|y| {
+            let mut row = Vec::with_capacity(opts.width as usize);
+            for x in 0..opts.width {
+                let (mut rgb, mut nrm, mut hit, mut depth) = (Vec3::ZERO, Vec3::ZERO, 0u32, 0.0f32);
+                for sy in 0..ss {
+                    for sx in 0..ss {
+                        let s = r.samples[((y * ss + sy) * sw + x * ss + sx) as usize];
+                        if s.prim == raster::EMPTY {
+                            rgb += Vec3::from(views::BACKGROUND);
+                            continue;
+                        }
+                        let p = &r.prims[s.prim as usize];
+                        let d = &prep.draws[p.draw as usize];
+                        let f = shade::Fragment {
+                            draw: d,
+                            material: prep.materials.get(d.material).unwrap_or(&default_material),
+                            tri: d.triangles[p.tri as usize],
+                            bary: p.whole_bary(s.b),
+                            back: p.back,
+                        };
+                        let out = views::shade(opts.view, &f, cam.eye, &lights, &opts.params);
+                        rgb += Vec3::from(out.color);
+                        nrm += out.normal;
+                        hit += 1;
+                        depth += s.depth;
+                    }
+                }
+                let n = (ss * ss) as f32;
+                let cov = hit as f32 / n;
+                let depth = if hit > 0 { depth / hit as f32 } else { f32::INFINITY };
+                row.push((rgb / n, nrm.normalize_or_zero(), cov, depth));
+            }
+            row
+        })
+        .collect();
+    let px = rows.into_iter().flatten();
+    let mut frame = Frame { width: opts.width, height: opts.height, rgb: Vec::new(), normal: Vec::new(), coverage: Vec::new(), depth: Vec::new() };
+    for (c, n, cov, d) in px {
+        frame.rgb.push(c.to_array());
+        frame.normal.push(n);
+        frame.coverage.push(cov);
+        frame.depth.push(d);
+    }
+    frame
+}

@@ -1,0 +1,210 @@
+//! `bumpbake preview IN -o OUT.png` and `bumpbake preview --reference A --compare B -o diff.png`.
+
+use bumpbake::output::write_atomic;
+use bumpbake::preview::compare::{compare, DiffKind};
+use bumpbake::preview::{render, Camera, CameraSpec, Light, Options, Params, Prepared, View};
+use bumpbake::scene::{ReadOptions, Scene};
+use bumpbake::{Error, Result};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Render an asset with the course notes' bump-mapping model on the CPU, or measure pipeline error.
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Examples:
+  bumpbake preview fixtures/khronos/NormalTangentMirrorTest.glb -o mirror.png --size 384x384 --ssaa 2
+  bumpbake preview fixtures/spot/spot.obj -o spot.png --yaw 150 --pitch 15 --light dir:-1,-1,-1 --light point:0,1,2@0.4
+  bumpbake preview --reference high.glb --compare low.glb -o diff.png --json")]
+pub struct Args {
+    /// Input mesh: .glb, .gltf or .obj (with its .mtl).
+    pub input: Option<PathBuf>,
+    /// Output image (.png).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Supersampling: N x N samples per pixel (1 to 8).
+    #[arg(long, default_value_t = 1)]
+    pub ssaa: u32,
+    /// Camera rotation about +Y in degrees (0 looks from +Z).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub yaw: f32,
+    /// Camera elevation in degrees (positive looks down).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub pitch: f32,
+    /// Camera distance from the centre of the bounds (default: fit the bounds).
+    #[arg(long)]
+    pub distance: Option<f32>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 40.0)]
+    pub fov: f32,
+    /// A light: dir:x,y,z (travelling along x,y,z), point:x,y,z or spot:x,y,z:dx,dy,dz:angle,
+    /// each optionally followed by @intensity. Repeat for several; none gives a default rig.
+    #[arg(long, allow_hyphen_values = true)]
+    pub light: Vec<String>,
+    /// What to show.
+    #[arg(long, value_enum, default_value = "shaded")]
+    pub view: ViewArg,
+    /// Pipeline error: the true surface (fine geometry with its own normals).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Pipeline error: the asset to measure against the reference (or against IN).
+    #[arg(long)]
+    pub compare: Option<PathBuf>,
+    /// What the difference image shows in compare mode.
+    #[arg(long, value_enum, default_value = "angle")]
+    pub diff: DiffArg,
+    /// Ambient term (fraction of the base colour).
+    #[arg(long, default_value_t = 0.06)]
+    pub ambient: f32,
+    /// Specular intensity.
+    #[arg(long, default_value_t = 0.25)]
+    pub specular: f32,
+    /// Blinn-Phong exponent.
+    #[arg(long, default_value_t = 32.0)]
+    pub shininess: f32,
+    /// Let URIs reach outside the input's folder.
+    #[arg(long)]
+    pub allow_outside: bool,
+    /// Print the report (and comparison figures) as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// No report on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewArg {
+    Shaded,
+    Normal,
+    Tangent,
+    Bitangent,
+    Handedness,
+    Nomap,
+    /// The difference between IN (or --reference) and --compare.
+    Diff,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum DiffArg {
+    Angle,
+    Shaded,
+}
+
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
+    let p = |v: &str| v.trim().parse::<u32>().ok().filter(|&x| (1..=16384).contains(&x)).ok_or_else(|| format!("'{s}': sizes are 1 to 16384"));
+    Ok((p(w)?, p(h)?))
+}
+
+fn read(path: &Path, allow_outside: bool) -> Result<Scene> {
+    Scene::read(path, &ReadOptions { allow_outside, ..Default::default() })
+}
+
+pub fn run(a: Args) -> Result<u8> {
+    if a.output.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("png")) != Some(true) {
+        return Err(Error::usage(format!("{}: the preview is written as PNG; name it .png", a.output.display())));
+    }
+    for (what, v) in [("--fov", a.fov), ("--ambient", a.ambient), ("--specular", a.specular), ("--shininess", a.shininess), ("--yaw", a.yaw), ("--pitch", a.pitch)] {
+        if !v.is_finite() || (what != "--yaw" && what != "--pitch" && v < 0.0) {
+            return Err(Error::usage(format!("preview: {what} {v} is not a usable value")));
+        }
+    }
+    if let Some(d) = a.distance {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(Error::usage(format!("preview: --distance {d} must be positive")));
+        }
+    }
+    let lights = a.light.iter().map(|l| Light::parse(l)).collect::<std::result::Result<Vec<_>, _>>().map_err(Error::usage)?;
+    let view = match a.view {
+        ViewArg::Shaded | ViewArg::Diff => View::Shaded,
+        ViewArg::Normal => View::Normal,
+        ViewArg::Tangent => View::Tangent,
+        ViewArg::Bitangent => View::Bitangent,
+        ViewArg::Handedness => View::Handedness,
+        ViewArg::Nomap => View::Nomap,
+    };
+    let opts = Options {
+        width: a.size.0,
+        height: a.size.1,
+        ssaa: a.ssaa,
+        camera: CameraSpec { yaw: a.yaw, pitch: a.pitch, distance: a.distance, fov: a.fov },
+        lights,
+        view,
+        params: Params { ambient: a.ambient, specular: a.specular, shininess: a.shininess },
+    };
+    opts.check()?;
+    let start = Instant::now();
+
+    if let Some(cand) = &a.compare {
+        let reference = match (&a.reference, &a.input) {
+            (Some(r), None) => r,
+            (None, Some(i)) => i,
+            (Some(_), Some(_)) => return Err(Error::usage("preview: give the reference either as IN or as --reference, not both")),
+            (None, None) => return Err(Error::usage("preview: --compare needs a reference (IN or --reference)")),
+        };
+        if a.view != ViewArg::Shaded && a.view != ViewArg::Diff {
+            return Err(Error::usage("preview: --compare writes the difference image; --view must be shaded or diff"));
+        }
+        let r = read(reference, a.allow_outside)?;
+        let c = read(cand, a.allow_outside)?;
+        let kind = match a.diff {
+            DiffArg::Angle => DiffKind::Angle,
+            DiffArg::Shaded => DiffKind::Shaded,
+        };
+        let (cmp, img) = compare(&r, &c, &opts, kind)?;
+        write_atomic(&a.output, &img.to_png())?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        if a.json {
+            let j = serde_json::json!({
+                "reference": reference, "compare": cand, "output": a.output, "time_ms": ms, "comparison": cmp,
+            });
+            println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
+        } else if !a.quiet {
+            eprintln!("preview: {} vs {} -> {} ({}x{}, {:.0} ms)", reference.display(), cand.display(), a.output.display(), cmp.width, cmp.height, ms);
+            eprintln!("  pixels compared {}, excluded near silhouettes {}", cmp.pixels_compared, cmp.pixels_excluded);
+            match cmp.normal_angle_deg {
+                Some(s) => eprintln!("  shading-normal angle: mean {:.3}°, p95 {:.3}°, max {:.3}°", s.mean, s.p95, s.max),
+                None => eprintln!("  shading-normal angle: no pixels to compare"),
+            }
+            match cmp.psnr_db {
+                Some(p) => eprintln!("  shaded PSNR {p:.2} dB"),
+                None => eprintln!("  shaded PSNR: identical"),
+            }
+        }
+        return Ok(0);
+    }
+
+    if a.view == ViewArg::Diff {
+        return Err(Error::usage("preview: --view diff needs --compare OTHER"));
+    }
+    if a.reference.is_some() {
+        return Err(Error::usage("preview: --reference needs --compare"));
+    }
+    let input = a.input.as_ref().ok_or_else(|| Error::usage("preview: no input file"))?;
+    let scene = read(input, a.allow_outside)?;
+    let t_read = start.elapsed().as_secs_f64() * 1e3;
+    let prep = Prepared::with_frames(&scene, matches!(opts.view, View::Tangent | View::Bitangent | View::Handedness))?;
+    let t_prep = start.elapsed().as_secs_f64() * 1e3;
+    let cam = Camera::framed(prep.bounds, &opts.camera, opts.width, opts.height);
+    let frame = render(&prep, &cam, &opts);
+    let t_render = start.elapsed().as_secs_f64() * 1e3;
+    write_atomic(&a.output, &frame.to_png())?;
+    let ms = start.elapsed().as_secs_f64() * 1e3;
+    let stages = serde_json::json!({ "read_ms": t_read, "prepare_ms": t_prep - t_read, "render_ms": t_render - t_prep, "write_ms": ms - t_render });
+    if a.json {
+        let j = serde_json::json!({
+            "input": input, "output": a.output, "view": opts.view.name(), "width": opts.width, "height": opts.height,
+            "ssaa": opts.ssaa, "triangles": prep.triangle_count(), "notes": prep.notes, "time_ms": ms, "stages": stages,
+        });
+        println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
+    } else if !a.quiet {
+        eprintln!("preview: {} -> {} ({}x{}, {} view, {} triangles, {:.0} ms)", input.display(), a.output.display(), opts.width, opts.height, opts.view.name(), prep.triangle_count(), ms);
+        eprintln!("  read {:.0} ms, prepare {:.0} ms, render {:.0} ms, write {:.0} ms", t_read, t_prep - t_read, t_render - t_prep, ms - t_render);
+        for n in &prep.notes {
+            eprintln!("  note: {n}");
+        }
+    }
+    Ok(0)
+}

@@ -1,0 +1,385 @@
+//! Turns a [`Scene`] into what the rasteriser draws: world-space triangle lists with complete
+//! vertex frames, and materials with decoded textures.
+//!
+//! Everything a renderer would otherwise have to guess is settled here, the way the conventions
+//! say a client should: missing normals become flat normals, missing tangents become MikkTSpace
+//! tangents (the same code `bumpbake tangents` runs), OBJ UVs are flipped to glTF's v-down, and a
+//! node transform that mirrors flips both the winding and `w`, so that `B = cross(N, T) * w`
+//! still points where the texture's +v-up axis lies on the surface.
+
+use super::texture::{Sampler, Texture};
+use crate::error::Result;
+use crate::scene::{flat_normals, PrimRef, Scene};
+use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
+use serde_json::Value;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// A texture as a material uses it.
+#[derive(Debug, Clone)]
+pub struct TexRef {
+    pub texture: Arc<Texture>,
+    pub sampler: Sampler,
+    /// Which UV set: 0 for `TEXCOORD_0`, 1 for `TEXCOORD_1`.
+    pub texcoord: u32,
+}
+
+/// The parts of a glTF material the seeds' shading model uses.
+#[derive(Debug, Clone)]
+pub struct Material {
+    pub base_color: Vec4,
+    pub base_texture: Option<TexRef>,
+    pub normal_texture: Option<TexRef>,
+    /// `normalTexture.scale`: multiplies the decoded x and y.
+    pub normal_scale: f32,
+    pub double_sided: bool,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material { base_color: Vec4::ONE, base_texture: None, normal_texture: None, normal_scale: 1.0, double_sided: false }
+    }
+}
+
+/// One primitive placed in the world: the rasteriser's unit of work.
+#[derive(Debug, Clone)]
+pub struct Draw {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    /// World-space unit tangent and handedness `w` (±1).
+    pub tangents: Vec<Vec4>,
+    /// UV sets 0 and 1 in glTF's convention (v down); set 1 is empty when absent.
+    pub uvs: [Vec<Vec2>; 2],
+    pub triangles: Vec<[u32; 3]>,
+    pub material: usize,
+    /// Where the primitive came from, for messages.
+    pub source: PrimRef,
+}
+
+/// A scene made ready to draw any number of times from any camera.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    pub draws: Vec<Draw>,
+    pub materials: Vec<Material>,
+    /// World-space bounds of everything drawn.
+    pub bounds: (Vec3, Vec3),
+    /// What was substituted or skipped, for the report.
+    pub notes: Vec<String>,
+}
+
+impl Prepared {
+    /// Reads every triangle primitive the scene shows (its default scene's node trees, or every
+    /// mesh when there are no nodes). Fails on a scene with nothing to draw.
+    ///
+    /// Primitives without TANGENT get MikkTSpace tangents only where a normal map needs them:
+    /// without a map any frame lights the same, and generating frames costs more than drawing.
+    pub fn new(scene: &Scene) -> Result<Prepared> {
+        Prepared::with_frames(scene, false)
+    }
+
+    /// [`Prepared::new`], and `all_frames` also generates MikkTSpace tangents for primitives
+    /// whose material has no normal map (for the tangent, bitangent and handedness views).
+    pub fn with_frames(scene: &Scene, all_frames: bool) -> Result<Prepared> {
+        let mut cx = Cx { scene, all_frames, textures: HashMap::new(), materials: Vec::new(), material_index: HashMap::new(), notes: Vec::new() };
+        let mut draws = Vec::new();
+        let mut prim_cache: HashMap<PrimRef, Option<Local>> = HashMap::new();
+        for (mesh, world) in instances(scene) {
+            let n = scene.json.pointer(&format!("/meshes/{mesh}/primitives")).and_then(|p| p.as_array()).map(|a| a.len()).unwrap_or(0);
+            for p in 0..n {
+                let r = PrimRef { mesh, primitive: p };
+                if !prim_cache.contains_key(&r) {
+                    let local = cx.local(r)?;
+                    prim_cache.insert(r, local);
+                }
+                if let Some(Some(local)) = prim_cache.get(&r) {
+                    let material = cx.material(r)?;
+                    draws.push(place(local, world, material, r));
+                }
+            }
+        }
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for d in &draws {
+            for t in &d.triangles {
+                for &i in t {
+                    let p = d.positions[i as usize];
+                    if p.is_finite() {
+                        lo = lo.min(p);
+                        hi = hi.max(p);
+                    }
+                }
+            }
+        }
+        if !(lo.is_finite() && hi.is_finite()) {
+            return Err(scene.err("nothing to draw: the scene shows no triangles"));
+        }
+        Ok(Prepared { draws, materials: cx.materials, bounds: (lo, hi), notes: cx.notes })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.draws.iter().map(|d| d.triangles.len()).sum()
+    }
+}
+
+/// A primitive in its mesh's own space, with every attribute the renderer needs.
+#[derive(Debug, Clone)]
+struct Local {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    tangents: Vec<Vec4>,
+    uvs: [Vec<Vec2>; 2],
+    triangles: Vec<[u32; 3]>,
+}
+
+struct Cx<'a> {
+    scene: &'a Scene,
+    all_frames: bool,
+    textures: HashMap<(usize, bool), Arc<Texture>>,
+    materials: Vec<Material>,
+    material_index: HashMap<Option<usize>, usize>,
+    notes: Vec<String>,
+}
+
+impl Cx<'_> {
+    fn local(&mut self, r: PrimRef) -> Result<Option<Local>> {
+        let s = self.scene;
+        let mut prim = s.primitive(r)?;
+        let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
+        if prim.mode != 4 {
+            self.notes.push(format!("{where_}: mode {} is not a triangle list; not drawn", prim.mode));
+            return Ok(None);
+        }
+        if prim.attr("POSITION").is_none() {
+            self.notes.push(format!("{where_}: no POSITION; not drawn"));
+            return Ok(None);
+        }
+        let uv_set = s.normal_texcoord(r).unwrap_or(0);
+        let uv_name = format!("TEXCOORD_{uv_set}");
+        let tangents_ok = prim.attr("TANGENT").map(|t| t.format.components() == 4).unwrap_or(false);
+        let has_map = s.material_of(r).and_then(|m| m.get("normalTexture")).is_some();
+        if !tangents_ok && (has_map || self.all_frames) && prim.attr(&uv_name).is_some() && prim.indices.len() >= 3 {
+            prim.indices.truncate(prim.indices.len() / 3 * 3);
+            // Exactly what `bumpbake tangents` would store, so the preview shows the tool's frames.
+            prim = crate::tangent::primitive_with_tangents(&prim, uv_set, s.uv_v_up, &Default::default());
+            if has_map {
+                self.notes.push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));
+            }
+        }
+        let mut positions: Vec<Vec3> = prim.positions().into_iter().map(Vec3::from).collect();
+        let mut normals: Option<Vec<Vec3>> = prim.attr("NORMAL").map(|n| n.to_f32::<3>().into_iter().map(Vec3::from).collect());
+        let mut tangents: Option<Vec<Vec4>> = prim.attr("TANGENT").filter(|t| t.format.components() == 4).map(|t| t.to_f32::<4>().into_iter().map(Vec4::from).collect());
+        let uv = |k: u32| -> Vec<Vec2> {
+            prim.attr(&format!("TEXCOORD_{k}"))
+                .map(|t| t.to_f32::<2>().into_iter().map(|[u, v]| if s.uv_v_up { Vec2::new(u, 1.0 - v) } else { Vec2::new(u, v) }).collect())
+                .unwrap_or_default()
+        };
+        let mut uvs = [uv(0), uv(1)];
+        let mut indices = prim.indices.clone();
+        indices.truncate(indices.len() / 3 * 3);
+
+        if normals.is_none() {
+            // glTF: a client must use flat normals, so every corner becomes its own vertex.
+            let corner_pos: Vec<[f32; 3]> = indices.iter().map(|&i| positions[i as usize].to_array()).collect();
+            let (n, _) = flat_normals(&corner_pos);
+            let gather3 = |v: &Vec<Vec2>| if v.is_empty() { Vec::new() } else { indices.iter().map(|&i| v[i as usize]).collect() };
+            uvs = [gather3(&uvs[0]), gather3(&uvs[1])];
+            tangents = tangents.map(|t| indices.iter().map(|&i| t[i as usize]).collect());
+            positions = corner_pos.into_iter().map(Vec3::from).collect();
+            normals = Some(n.into_iter().map(Vec3::from).collect());
+            indices = (0..positions.len() as u32).collect();
+        }
+        let normals: Vec<Vec3> = normals.unwrap_or_default().into_iter().map(|n| unit_or(n, Vec3::Z)).collect();
+        let tangents: Vec<Vec4> = match tangents {
+            Some(t) => t.into_iter().zip(&normals).map(|(t, &n)| sane_tangent(t, n)).collect(),
+            None => normals.iter().map(|&n| sane_tangent(Vec4::ZERO, n)).collect(),
+        };
+        for u in uvs.iter_mut() {
+            if u.len() != positions.len() {
+                u.clear();
+            }
+        }
+        let triangles = indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        Ok(Some(Local { positions, normals, tangents, uvs, triangles }))
+    }
+
+    fn material(&mut self, r: PrimRef) -> Result<usize> {
+        let idx = self.scene.prim_json(r).get("material").and_then(|m| m.as_u64()).map(|m| m as usize);
+        if let Some(&i) = self.material_index.get(&idx) {
+            return Ok(i);
+        }
+        let m = match idx.and_then(|i| self.scene.json.pointer(&format!("/materials/{i}"))) {
+            Some(mj) => self.read_material(mj)?,
+            None => Material::default(),
+        };
+        self.materials.push(m);
+        let i = self.materials.len() - 1;
+        self.material_index.insert(idx, i);
+        Ok(i)
+    }
+
+    fn read_material(&mut self, mj: &Value) -> Result<Material> {
+        let mut m = Material::default();
+        if let Some(f) = mj.pointer("/pbrMetallicRoughness/baseColorFactor").and_then(|f| f.as_array()) {
+            let c: Vec<f32> = f.iter().map(|x| x.as_f64().unwrap_or(1.0) as f32).collect();
+            if c.len() == 4 && c.iter().all(|x| x.is_finite()) {
+                m.base_color = Vec4::from_slice(&c);
+            }
+        }
+        if let Some(t) = mj.pointer("/pbrMetallicRoughness/baseColorTexture") {
+            m.base_texture = self.tex_ref(t, true)?;
+        }
+        if let Some(t) = mj.get("normalTexture") {
+            m.normal_texture = self.tex_ref(t, false)?;
+            m.normal_scale = t.get("scale").and_then(|s| s.as_f64()).filter(|s| s.is_finite()).unwrap_or(1.0) as f32;
+        }
+        m.double_sided = mj.get("doubleSided").and_then(|d| d.as_bool()).unwrap_or(false);
+        Ok(m)
+    }
+
+    fn tex_ref(&mut self, info: &Value, srgb: bool) -> Result<Option<TexRef>> {
+        let s = self.scene;
+        let Some(ti) = info.get("index").and_then(|i| i.as_u64()) else { return Ok(None) };
+        let tj = s.json.pointer(&format!("/textures/{ti}")).ok_or_else(|| s.err(format!("texture {ti} does not exist")))?;
+        let Some(img) = tj.get("source").and_then(|i| i.as_u64()).map(|i| i as usize) else {
+            self.notes.push(format!("texture {ti} has no PNG/JPEG source; drawn without it"));
+            return Ok(None);
+        };
+        let sampler = Sampler::from_json(tj.get("sampler").and_then(|i| i.as_u64()).and_then(|i| s.json.pointer(&format!("/samplers/{i}"))));
+        let texcoord = info.pointer("/extensions/KHR_texture_transform/texCoord").or_else(|| info.get("texCoord")).and_then(|t| t.as_u64()).unwrap_or(0);
+        if texcoord > 1 {
+            self.notes.push(format!("texture {ti} reads TEXCOORD_{texcoord}; only sets 0 and 1 are drawn"));
+            return Ok(None);
+        }
+        if info.pointer("/extensions/KHR_texture_transform").is_some() {
+            self.notes.push(format!("texture {ti}: KHR_texture_transform offset/scale/rotation is not applied"));
+        }
+        let texture = match self.textures.get(&(img, srgb)) {
+            Some(t) => t.clone(),
+            None => {
+                let bytes = image_bytes(s, img)?;
+                let t = Arc::new(Texture::decode(&bytes, srgb).map_err(|e| s.err(format!("image {img}: {e}")))?);
+                self.textures.insert((img, srgb), t.clone());
+                t
+            }
+        };
+        Ok(Some(TexRef { texture, sampler, texcoord: texcoord as u32 }))
+    }
+}
+
+/// The encoded bytes of `images[img]`, from a URI (data or file) or a buffer view.
+fn image_bytes(s: &Scene, img: usize) -> Result<Vec<u8>> {
+    let ij = s.json.pointer(&format!("/images/{img}")).ok_or_else(|| s.err(format!("image {img} does not exist")))?;
+    if let Some(uri) = ij.get("uri").and_then(|u| u.as_str()) {
+        return crate::scene::uri::read(uri, &s.base_dir, &s.source, s.allow_outside);
+    }
+    let bv = ij.get("bufferView").and_then(|b| b.as_u64()).ok_or_else(|| s.err(format!("image {img} has neither uri nor bufferView")))?;
+    let v = s.json.pointer(&format!("/bufferViews/{bv}")).ok_or_else(|| s.err(format!("image {img}: bufferView {bv} does not exist")))?;
+    let b = v.get("buffer").and_then(|b| b.as_u64()).unwrap_or(0) as usize;
+    let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    s.buffers
+        .get(b)
+        .and_then(|buf| buf.get(off..off.checked_add(len)?))
+        .map(|x| x.to_vec())
+        .ok_or_else(|| s.err(format!("image {img}: bufferView {bv} lies outside its buffer")))
+}
+
+/// Every (mesh, world matrix) the scene shows.
+fn instances(scene: &Scene) -> Vec<(usize, Mat4)> {
+    let j = &scene.json;
+    let nodes = j.get("nodes").and_then(|n| n.as_array()).map(|n| n.as_slice()).unwrap_or(&[]);
+    let roots: Vec<usize> = if let Some(sc) = j.get("scenes").and_then(|s| s.as_array()).filter(|s| !s.is_empty()) {
+        let si = j.get("scene").and_then(|s| s.as_u64()).unwrap_or(0) as usize;
+        let sc = sc.get(si).or(sc.first());
+        sc.and_then(|s| s.get("nodes")).and_then(|n| n.as_array()).map(|a| a.iter().filter_map(|x| x.as_u64()).map(|x| x as usize).collect()).unwrap_or_default()
+    } else if !nodes.is_empty() {
+        let mut child = vec![false; nodes.len()];
+        for n in nodes {
+            for c in n.get("children").and_then(|c| c.as_array()).into_iter().flatten().filter_map(|c| c.as_u64()) {
+                if let Some(x) = child.get_mut(c as usize) {
+                    *x = true;
+                }
+            }
+        }
+        (0..nodes.len()).filter(|&i| !child[i]).collect()
+    } else {
+        let meshes = j.get("meshes").and_then(|m| m.as_array()).map(|m| m.len()).unwrap_or(0);
+        return (0..meshes).map(|m| (m, Mat4::IDENTITY)).collect();
+    };
+    let mut out = Vec::new();
+    let mut stack: Vec<(usize, Mat4, usize)> = roots.into_iter().rev().map(|r| (r, Mat4::IDENTITY, 0)).collect();
+    while let Some((n, parent, depth)) = stack.pop() {
+        // glTF node graphs are trees; a cyclic or absurdly deep file must not hang the preview.
+        let Some(node) = nodes.get(n) else { continue };
+        if depth > 64 || out.len() > 1_000_000 {
+            continue;
+        }
+        let world = parent * local_matrix(node);
+        if let Some(m) = node.get("mesh").and_then(|m| m.as_u64()) {
+            out.push((m as usize, world));
+        }
+        let children: Vec<usize> = node.get("children").and_then(|c| c.as_array()).into_iter().flatten().filter_map(|c| c.as_u64()).map(|c| c as usize).collect();
+        for c in children.into_iter().rev() {
+            stack.push((c, world, depth + 1));
+        }
+    }
+    out
+}
+
+fn floats(v: Option<&Value>, n: usize) -> Option<Vec<f32>> {
+    let a = v?.as_array()?;
+    let f: Vec<f32> = a.iter().map(|x| x.as_f64().map(|x| x as f32)).collect::<Option<_>>()?;
+    (f.len() == n && f.iter().all(|x| x.is_finite())).then_some(f)
+}
+
+fn local_matrix(node: &Value) -> Mat4 {
+    if let Some(m) = floats(node.get("matrix"), 16) {
+        return Mat4::from_cols_slice(&m);
+    }
+    let t = floats(node.get("translation"), 3).map(|v| Vec3::from_slice(&v)).unwrap_or(Vec3::ZERO);
+    let r = floats(node.get("rotation"), 4).map(|v| Quat::from_slice(&v).normalize()).filter(|q| q.is_finite()).unwrap_or(Quat::IDENTITY);
+    let s = floats(node.get("scale"), 3).map(|v| Vec3::from_slice(&v)).unwrap_or(Vec3::ONE);
+    Mat4::from_scale_rotation_translation(s, r, t)
+}
+
+fn place(l: &Local, world: Mat4, material: usize, source: PrimRef) -> Draw {
+    let m3 = Mat3::from_mat4(world);
+    let det = m3.determinant();
+    let nm = if det.abs() > 1e-30 && det.is_finite() { m3.inverse().transpose() } else { m3 };
+    let mirror = det < 0.0;
+    let positions = l.positions.iter().map(|&p| world.transform_point3(p)).collect();
+    let normals: Vec<Vec3> = l.normals.iter().map(|&n| unit_or(nm * n, Vec3::Z)).collect();
+    let tangents = l
+        .tangents
+        .iter()
+        .zip(&normals)
+        .map(|(&t, &n)| {
+            let w = if mirror { -t.w } else { t.w };
+            sane_tangent((m3 * t.truncate()).extend(w), n)
+        })
+        .collect();
+    let triangles = if mirror { l.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect() } else { l.triangles.clone() };
+    Draw { positions, normals, tangents, uvs: l.uvs.clone(), triangles, material, source }
+}
+
+fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let n = v.normalize_or_zero();
+    if n == Vec3::ZERO || !n.is_finite() {
+        fallback
+    } else {
+        n
+    }
+}
+
+/// A usable frame from whatever the file holds: unit, finite, not parallel to `n`, `w` = ±1.
+/// Where there is no tangent the frame is arbitrary; without a normal map it only orients the
+/// tangent space the lighting runs in, which does not change the lit result.
+fn sane_tangent(t: Vec4, n: Vec3) -> Vec4 {
+    let w = if t.w < 0.0 { -1.0 } else { 1.0 };
+    let v = t.truncate();
+    let ortho = (v - n * v.dot(n)).normalize_or_zero();
+    if v.is_finite() && ortho != Vec3::ZERO && ortho.is_finite() {
+        return v.normalize().extend(w);
+    }
+    n.any_orthonormal_vector().extend(w)
+}
