@@ -4,6 +4,36 @@
 
 use super::{Primitive, Stream};
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// FxHash (rustc's): the keys are attribute bytes we made ourselves, so a fast non-keyed hash is
+/// safe, and SipHash would cost more than the rest of the weld.
+#[derive(Default)]
+struct Fx(u64);
+
+impl Hasher for Fx {
+    fn write(&mut self, bytes: &[u8]) {
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            self.add(u64::from_le_bytes(c.try_into().expect("8 bytes")));
+        }
+        for &b in chunks.remainder() {
+            self.add(b as u64);
+        }
+    }
+    fn write_usize(&mut self, n: usize) {
+        self.add(n as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+impl Fx {
+    fn add(&mut self, w: u64) {
+        self.0 = (self.0.rotate_left(5) ^ w).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
 
 /// Builds an indexed primitive from streams that hold one element per corner.
 pub fn weld(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)>>, mode: u32) -> Primitive {
@@ -16,7 +46,7 @@ pub fn weld(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)
             keys.extend_from_slice(s.elem(c));
         }
     }
-    let mut first: HashMap<&[u8], u32> = HashMap::with_capacity(corners);
+    let mut first: HashMap<&[u8], u32, BuildHasherDefault<Fx>> = HashMap::with_capacity_and_hasher(corners, Default::default());
     let mut order: Vec<u32> = Vec::new();
     let mut indices = Vec::with_capacity(corners);
     for c in 0..corners {

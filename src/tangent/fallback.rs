@@ -75,10 +75,11 @@ pub fn repair(frames: &mut [Option<[f32; 4]>], normals: &[Vec3], vertex: &[u32])
     let mut counts = FallbackCounts::default();
     let ok: Vec<bool> = frames.iter().zip(normals).map(|(f, &n)| f.map(|t| is_valid(t, n)).unwrap_or(false)).collect();
     // First valid corner of each vertex, to lend from across triangles.
-    let mut by_vertex: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    let n_vertices = vertex.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
+    let mut by_vertex = vec![usize::MAX; n_vertices];
     for (c, &good) in ok.iter().enumerate() {
-        if good {
-            by_vertex.entry(vertex[c]).or_insert(c);
+        if good && by_vertex[vertex[c] as usize] == usize::MAX {
+            by_vertex[vertex[c] as usize] = c;
         }
     }
     let mut out = Vec::with_capacity(frames.len());
@@ -93,7 +94,7 @@ pub fn repair(frames: &mut [Option<[f32; 4]>], normals: &[Vec3], vertex: &[u32])
         }
         let n = normals[c];
         let tri = c / 3 * 3;
-        let lenders = (tri..tri + 3).filter(|&k| k != c && ok[k]).chain(by_vertex.get(&vertex[c]).copied());
+        let lenders = (tri..tri + 3).filter(|&k| k != c && ok[k]).chain(Some(by_vertex[vertex[c] as usize]).filter(|&k| k != usize::MAX));
         let mut chosen = None;
         for k in lenders {
             let t = frames[k].expect("valid frames exist");
