@@ -1,6 +1,7 @@
 //! Tangent frames: MikkTSpace generation ([`mikk`]), the fallback for corners the reference
 //! leaves undefined ([`fallback`]), and the split/merge of vertices that follows ([`split`]).
 
+pub mod fast;
 pub mod mikk;
 
 /// An indexed triangle list as MikkTSpace sees it: one normal and one UV per vertex.
