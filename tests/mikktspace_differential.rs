@@ -221,26 +221,47 @@ fn grid(r: &mut Words) -> Mesh {
 
 fn fan(r: &mut Words) -> Mesh {
     let mut m = Mesh::default();
-    let k = 33 + r.below(88) as usize;
-    let closed = r.below(2) == 0;
-    let wild = r.below(8) == 0;
+    let uvmode = r.below(5);
+    // Mode 3 and 4 need an even count: rim vertex i + k/2 is the exact negation of vertex i.
+    let k = (33 + r.below(88) as usize) & !1;
+    let closed = r.below(4) != 0;
+    let wild = r.below(6) == 0;
+    // Tiny scales push normalised vectors off unit length (subnormal intermediate values).
+    let scale = match r.below(8) {
+        0 => 1.0e-21,
+        1 => 1.0e-19,
+        _ => 1.0,
+    };
     m.p.push([0.0, 0.0, 0.0]);
     m.n.push([0.0, 0.0, 1.0]);
-    m.uv.push([0.5, 0.5]);
-    let uvmode = r.below(4);
+    m.uv.push([0.0, 0.0]);
+    let half = k / 2;
+    let mut rim: Vec<[f32; 3]> = Vec::new();
     for i in 0..k {
-        let a = i as f32 / k as f32 * std::f32::consts::TAU;
-        let p = [a.cos(), a.sin(), if r.below(5) == 0 { 0.1 } else { 0.0 }];
+        let p = if i < half {
+            let a = i as f32 / k as f32 * std::f32::consts::TAU;
+            let z = if r.below(5) == 0 { 0.1 } else { 0.0 };
+            [a.cos() * scale, a.sin() * scale, z * scale]
+        } else {
+            let q = rim[i - half];
+            [-q[0], -q[1], q[2]]
+        };
+        rim.push(p);
+    }
+    for (i, &p) in rim.iter().enumerate() {
+        let mut p = p;
+        if wild && r.below(10) == 0 {
+            p[r.below(3) as usize] = WILD[r.below(WILD.len() as u32) as usize];
+        }
         m.p.push(p);
         m.n.push(if r.below(4) == 0 { normal(r, wild) } else { [0.0, 0.0, 1.0] });
+        let (x, y) = (p[0] / scale, p[1] / scale);
         let uv = match uvmode {
-            0 => [0.5 + 0.5 * p[0], 0.5 + 0.5 * p[1]],
+            0 => [0.5 + 0.5 * x, 0.5 + 0.5 * y],
             1 => [uvc(r, wild), uvc(r, wild)],
-            // Exact quarter-turn rotations: exactly opposite tangents within one group.
-            _ => {
-                let q = r.below(4);
-                let (x, y) = (p[0], p[1]);
-                let (x, y) = match q {
+            2 => {
+                // Exact quarter-turn rotations of a planar map.
+                let (x, y) = match r.below(4) {
                     0 => (x, y),
                     1 => (-y, x),
                     2 => (-x, -y),
@@ -248,12 +269,24 @@ fn fan(r: &mut Words) -> Mesh {
                 };
                 [0.5 + 0.5 * x, 0.5 + 0.5 * y]
             }
+            // uv = z^2: the tangent turns once around the fan, and the exact negation of the
+            // rim gives exactly opposite tangents half a turn apart (dot products at -1).
+            _ => {
+                let (x, y) = if i >= half { (-x, -y) } else { (x, y) };
+                [x * x - y * y, 2.0 * x * y]
+            }
         };
         m.uv.push(uv);
     }
+    // Mode 4: the rim order interleaves the halves, so both appear in one closed fan order.
     let last = if closed { k } else { k - 1 };
+    let order: Vec<usize> = if uvmode == 4 {
+        (0..k).map(|i| if i % 2 == 0 { i / 2 } else { half + i / 2 }).collect()
+    } else {
+        (0..k).collect()
+    };
     for i in 0..last {
-        let (a, b) = (1 + i as u32, 1 + ((i + 1) % k) as u32);
+        let (a, b) = (1 + order[i] as u32, 1 + order[(i + 1) % k] as u32);
         m.idx.extend([0, a, b]);
     }
     shuffle(r, &mut m);

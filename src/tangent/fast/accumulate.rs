@@ -292,3 +292,126 @@ fn large(ms: &[Member], out: &mut [V3]) {
         };
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reference's definition, literally: per member, its sub-group, summed in order.
+    fn brute(ms: &[Member], out: &mut [V3]) {
+        for a in 0..ms.len() {
+            let mut sum = [0.0f32; 3];
+            for b in 0..ms.len() {
+                let inc = ms[a].gwa || ms[b].gwa || a == b || compatible(&ms[a], &ms[b]);
+                if inc && !ms[b].gwa {
+                    sum = add(sum, ms[b].c);
+                }
+            }
+            out[a] = finish(sum);
+        }
+    }
+
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+        fn f(&mut self) -> f32 {
+            (self.next() >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        }
+        fn below(&mut self, n: u64) -> u64 {
+            self.next() % n
+        }
+    }
+
+    fn vector(r: &mut Rng, earlier: &[V3]) -> V3 {
+        match r.below(12) {
+            0 | 1 if !earlier.is_empty() => {
+                let e = earlier[r.below(earlier.len() as u64) as usize];
+                [-e[0], -e[1], -e[2]]
+            }
+            2 if !earlier.is_empty() => earlier[r.below(earlier.len() as u64) as usize],
+            3 => [0.0; 3],
+            4 if r.below(4) == 0 => [f32::NAN, 0.0, 1.0],
+            5 if r.below(4) == 0 => {
+                // Off unit length, or infinite.
+                match r.below(3) {
+                    0 => [1.001, 0.0, 0.0],
+                    1 => [f32::INFINITY, 1.0, 0.0],
+                    _ => [-0.7, -0.7, 0.2],
+                }
+            }
+            6 => {
+                // Axis-aligned units and their near-antipodes (rounding decides).
+                let ax = r.below(3) as usize;
+                let mut v = [0.0; 3];
+                v[ax] = if r.below(2) == 0 { 1.0 } else { -1.0 };
+                v
+            }
+            _ => normalized_or_zero([r.f(), r.f(), r.f()]),
+        }
+    }
+
+    #[test]
+    fn large_path_equals_definition() {
+        let mut r = Rng(7);
+        let mut differing = 0;
+        for case in 0..400 {
+            let m = 33 + r.below(150) as usize;
+            let mut ss: Vec<V3> = Vec::new();
+            let mut ts: Vec<V3> = Vec::new();
+            let mut ms = Vec::new();
+            for _ in 0..m {
+                let s = vector(&mut r, &ss);
+                let t = vector(&mut r, &ts);
+                ss.push(s);
+                ts.push(t);
+                let gwa = r.below(20) == 0;
+                let c = if gwa { [0.0; 3] } else { scale(r.f().abs() * 3.0, s) };
+                ms.push(Member { s, t, gwa, c });
+            }
+            let mut a = vec![[0.0f32; 3]; m];
+            let mut b = vec![[0.0f32; 3]; m];
+            large(&ms, &mut a);
+            brute(&ms, &mut b);
+            for i in 0..m {
+                let same = a[i].iter().zip(&b[i]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
+                assert!(same, "case {case} member {i}: {:?} vs {:?}", a[i], b[i]);
+            }
+            // Count cases whose outputs are not all equal (exclusions actually happened).
+            if b.iter().any(|v| v.iter().zip(&b[0]).any(|(x, y)| x.to_bits() != y.to_bits())) {
+                differing += 1;
+            }
+        }
+        assert!(differing > 100, "too few cases exercise exclusions: {differing}");
+    }
+
+    #[test]
+    fn small_path_equals_definition() {
+        let mut r = Rng(11);
+        for _ in 0..2000 {
+            let m = 1 + r.below(BRUTE_MAX as u64) as usize;
+            let mut ss: Vec<V3> = Vec::new();
+            let mut ms = Vec::new();
+            for _ in 0..m {
+                let s = vector(&mut r, &ss);
+                ss.push(s);
+                let t = vector(&mut r, &ss);
+                let gwa = r.below(10) == 0;
+                let c = if gwa { [0.0; 3] } else { scale(r.f().abs(), t) };
+                ms.push(Member { s, t, gwa, c });
+            }
+            let mut a = vec![[0.0f32; 3]; m];
+            let mut b = vec![[0.0f32; 3]; m];
+            small(&ms, &mut a);
+            brute(&ms, &mut b);
+            for i in 0..m {
+                assert!(a[i].iter().zip(&b[i]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan())));
+            }
+        }
+    }
+}
