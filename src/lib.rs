@@ -11,6 +11,7 @@
 //! - [`preview`]: a CPU reference renderer of the course notes' shading model.
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
 
+pub mod bench;
 pub mod error;
 pub mod normalmap;
 pub mod output;
