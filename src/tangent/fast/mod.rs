@@ -67,6 +67,14 @@ pub enum Unsupported {
 /// reference gives no answer. The vector has one entry per index (a trailing partial triangle
 /// gets `None`, as with the reference wrapper).
 pub fn generate(mesh: &TriMesh) -> Result<Vec<Option<[f32; 4]>>, Unsupported> {
+    generate_timed(mesh, &mut crate::report::Timings::default())
+}
+
+/// [`generate`], recording the wall time of each stage in `timings`.
+pub fn generate_timed(
+    mesh: &TriMesh,
+    timings: &mut crate::report::Timings,
+) -> Result<Vec<Option<[f32; 4]>>, Unsupported> {
     let n_faces = mesh.indices.len() / 3;
     if n_faces.checked_mul(3).is_none_or(|n| n >= (u32::MAX as usize) - 4) {
         return Err(Unsupported::TooLarge);
@@ -80,14 +88,15 @@ pub fn generate(mesh: &TriMesh) -> Result<Vec<Option<[f32; 4]>>, Unsupported> {
     if n_faces == 0 {
         return Ok(out);
     }
-    let mut tri = triangles::Triangles::build(&c);
+    let mut tri = timings.time("triangles", || triangles::Triangles::build(&c));
     let ng = tri.n_good;
-    let welded = weld::weld(&c, &tri.order);
+    let welded = timings.time("weld", || weld::weld(&c, &tri.order));
     let w = &welded[..3 * ng];
-    let nb = neighbors::build(w, 3 * n_faces);
-    let mut grp = groups::build(w, &nb, &mut tri);
+    let nb = timings.time("neighbors", || neighbors::build(w, 3 * n_faces));
+    let mut grp = timings.time("groups", || groups::build(w, &nb, &mut tri));
     drop(nb);
-    let vals = accumulate_all(&c, w, &tri, &mut grp);
+    let vals = timings.time("accumulate", || accumulate_all(&c, w, &tri, &mut grp));
+    let t_out = std::time::Instant::now();
     for g in 0..grp.rep.len() {
         let sign = if grp.orient[g] { 1.0 } else { -1.0 };
         let range = grp.start[g] as usize..grp.start[g + 1] as usize;
@@ -99,6 +108,7 @@ pub fn generate(mesh: &TriMesh) -> Result<Vec<Option<[f32; 4]>>, Unsupported> {
     if ng < tri.order.len() {
         degenerate(&welded, &tri, n_faces, &mut out);
     }
+    timings.stages.push(("output".into(), t_out.elapsed().as_secs_f64() * 1e3));
     Ok(out)
 }
 
