@@ -27,7 +27,7 @@ const THRESHOLD: f32 = -1.0;
 pub(crate) const BRUTE_MAX: usize = 32;
 
 /// What one group needs to know about one member.
-struct Member {
+pub(crate) struct Member {
     s: V3,
     t: V3,
     gwa: bool,
@@ -49,11 +49,11 @@ pub(crate) fn group_tangents(
     rep: u32,
     members: &[u32],
     out: &mut [V3],
+    scratch: &mut Vec<Member>,
 ) {
     let n = c.nrm(rep as usize);
-    let ms: Vec<Member> = members
-        .iter()
-        .map(|&k| {
+    scratch.clear();
+    scratch.extend(members.iter().map(|&k| {
             let (t, j) = ((k / 3) as usize, (k % 3) as usize);
             let s = project(tri.s[t], n);
             let tt = project(tri.t[t], n);
@@ -72,13 +72,45 @@ pub(crate) fn group_tangents(
                 scale(acos(cos), s)
             };
             Member { s, t: tt, gwa, c: cc }
-        })
-        .collect();
-    if ms.len() <= BRUTE_MAX {
-        small(&ms, out);
+    }));
+    if all_compatible(scratch) {
+        // Every sub-group is the whole group: one sum, in member order.
+        let mut sum = [0.0f32; 3];
+        for mb in scratch.iter().filter(|x| !x.gwa) {
+            sum = add(sum, mb.c);
+        }
+        out.fill(finish(sum));
+    } else if scratch.len() <= BRUTE_MAX {
+        small(scratch, out);
     } else {
-        large(&ms, out);
+        large(scratch, out);
     }
+}
+
+/// A sufficient test, linear in the group size, that every pair of non-"any" members passes
+/// the threshold: all vectors unit length (within 1e-3) and within about 53° of the first
+/// member's. Then any two are within about 107° of each other, so their dot products are
+/// near -0.29 or above, far from -1 whatever the rounding.
+fn all_compatible(ms: &[Member]) -> bool {
+    let near_unit = |v: V3| {
+        let l = dot(v, v);
+        l > 0.999 && l < 1.001
+    };
+    let mut pivot: Option<&Member> = None;
+    for m in ms.iter().filter(|x| !x.gwa) {
+        if !near_unit(m.s) || !near_unit(m.t) {
+            return false;
+        }
+        match pivot {
+            None => pivot = Some(m),
+            Some(p) => {
+                if !(dot(p.s, m.s) > 0.6 && dot(p.t, m.t) > 0.6) {
+                    return false;
+                }
+            }
+        }
+    }
+    true
 }
 
 fn finish(sum: V3) -> V3 {
@@ -88,7 +120,8 @@ fn finish(sum: V3) -> V3 {
 /// Direct evaluation: exclusion bit masks, one sum per distinct mask.
 fn small(ms: &[Member], out: &mut [V3]) {
     let m = ms.len();
-    let mut cache: Vec<(u64, V3)> = Vec::new();
+    let mut cache = [(0u64, [0.0f32; 3]); BRUTE_MAX];
+    let mut cached = 0usize;
     for a in 0..m {
         let mut incl: u64 = 0;
         for b in 0..m {
@@ -96,7 +129,7 @@ fn small(ms: &[Member], out: &mut [V3]) {
                 incl |= 1 << b;
             }
         }
-        let v = match cache.iter().find(|x| x.0 == incl) {
+        let v = match cache[..cached].iter().find(|x| x.0 == incl) {
             Some(x) => x.1,
             None => {
                 let mut sum = [0.0f32; 3];
@@ -106,7 +139,8 @@ fn small(ms: &[Member], out: &mut [V3]) {
                     }
                 }
                 let v = finish(sum);
-                cache.push((incl, v));
+                cache[cached] = (incl, v);
+                cached += 1;
                 v
             }
         };
@@ -388,6 +422,37 @@ mod tests {
             }
         }
         assert!(differing > 100, "too few cases exercise exclusions: {differing}");
+    }
+
+    #[test]
+    fn quick_test_implies_definition() {
+        let mut r = Rng(5);
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let m = 1 + r.below(60) as usize;
+            let base = [normalized_or_zero([r.f(), r.f(), r.f()]), normalized_or_zero([r.f(), r.f(), r.f()])];
+            let spread = [0.1f32, 0.5, 0.9, 1.5][r.below(4) as usize];
+            let ms: Vec<Member> = (0..m)
+                .map(|_| {
+                    let jitter = |v: V3, r: &mut Rng| {
+                        normalized_or_zero([v[0] + spread * r.f(), v[1] + spread * r.f(), v[2] + spread * r.f()])
+                    };
+                    let s = jitter(base[0], &mut r);
+                    let t = jitter(base[1], &mut r);
+                    let gwa = r.below(15) == 0;
+                    Member { s, t, gwa, c: scale(r.f().abs(), s) }
+                })
+                .collect();
+            if all_compatible(&ms) {
+                hits += 1;
+                for a in 0..m {
+                    for b in 0..m {
+                        assert!(ms[a].gwa || ms[b].gwa || compatible(&ms[a], &ms[b]));
+                    }
+                }
+            }
+        }
+        assert!(hits > 500, "{hits}");
     }
 
     #[test]

@@ -138,11 +138,12 @@ fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut 
     let (start, rep) = (&grp.start, &grp.rep);
     batches.into_par_iter().for_each(|(g0, g1, ms, vs)| {
         let base = start[g0] as usize;
+        let mut scratch = Vec::new();
         for g in g0..g1 {
             let r = start[g] as usize - base..start[g + 1] as usize - base;
             let m = &mut ms[r.clone()];
             m.sort_unstable();
-            accumulate::group_tangents(c, w, tri, rep[g], m, &mut vs[r]);
+            accumulate::group_tangents(c, w, tri, rep[g], m, &mut vs[r], &mut scratch);
         }
     });
     vals

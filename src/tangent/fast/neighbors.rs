@@ -33,77 +33,96 @@ pub(crate) fn build(w: &[u32], id_space: usize) -> Vec<u32> {
     if n_edges == 0 {
         return nb;
     }
-    let i0_of = |e: usize| {
-        let (a, b) = edge_ends(w, e);
-        a.min(b)
-    };
+    let i0: Vec<u32> = (0..n_edges)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .map(|e| {
+            let (a, b) = edge_ends(w, e);
+            a.min(b)
+        })
+        .collect();
+    let max_i0 = i0.par_iter().copied().max().unwrap_or(0);
     // Counting sort of edges by i0 (stable: triangle order within an i0).
     let mut start = vec![0u32; id_space + 1];
-    let mut max_i0 = 0u32;
-    for e in 0..n_edges {
-        let i0 = i0_of(e);
-        max_i0 = max_i0.max(i0);
-        start[i0 as usize + 1] += 1;
+    for &k in &i0 {
+        start[k as usize + 1] += 1;
     }
-    for i in 0..id_space {
-        start[i + 1] += start[i];
+    let mut acc = 0u32;
+    for s in start.iter_mut() {
+        acc += *s;
+        *s = acc;
     }
+    // start[i] is now the end of bucket i - 1, i.e. the start of bucket i.
     let mut by_i0 = vec![0u32; n_edges];
     {
-        let mut cursor: Vec<u32> = start[..id_space].to_vec();
-        for e in 0..n_edges {
-            let i0 = i0_of(e) as usize;
-            by_i0[cursor[i0] as usize] = e as u32;
-            cursor[i0] += 1;
+        let mut cursor = start;
+        for (e, &k) in i0.iter().enumerate() {
+            let c = &mut cursor[k as usize];
+            by_i0[*c as usize] = e as u32;
+            *c += 1;
         }
+        start = cursor; // cursor[i] = end of bucket i
     }
-    let tail_lo = start[max_i0 as usize] as usize;
+    drop(i0);
+    let tail_lo = if max_i0 == 0 { 0 } else { start[max_i0 as usize - 1] as usize };
     let tail_len = n_edges - tail_lo;
     // Pair every i0 bucket except the quirky last one (when it needs the replay).
     let replay = tail_len >= 3;
     let normal_end = if replay { tail_lo } else { n_edges };
-    let pairs: Vec<(u32, u32)> = by_i0[..normal_end]
-        .par_chunk_by(|&a, &b| i0_of(a as usize) == i0_of(b as usize))
-        .flat_map_iter(|bucket| {
-            let mut v: Vec<(u32, u32)> =
-                bucket.iter().map(|&e| (edge_ends_max(w, e as usize), e)).collect();
-            if v.len() > 1 {
-                // (i1, edge) order is (i1, triangle) order: one edge per triangle and key.
-                v.sort_unstable();
-            }
-            let mut out = Vec::new();
-            for run in v.chunk_by(|a, b| a.0 == b.0) {
-                pair_run(w, run.iter().map(|x| x.1), &mut out);
-            }
-            out
-        })
-        .collect();
+    let mut scratch: Vec<(u32, u32)> = Vec::new();
+    let mut lo = 0usize;
+    while lo < normal_end {
+        let k = i0_of(w, by_i0[lo] as usize);
+        let hi = (start[k as usize] as usize).min(normal_end);
+        pair_bucket(w, &by_i0[lo..hi], &mut scratch, &mut nb);
+        lo = hi;
+    }
     if replay {
-        let mut tail = legacy_tail(w, max_i0);
+        let tail = legacy_tail(w, max_i0);
         // Runs of equal i1, each sorted by triangle, except the last run (the off-by-one).
-        let mut runs: Vec<Vec<u32>> = Vec::new();
-        for run in tail.chunk_by_mut(|&a, &b| edge_ends_max(w, a as usize) == edge_ends_max(w, b as usize)) {
-            runs.push(run.to_vec());
-        }
-        let last = runs.len().saturating_sub(1);
-        let mut out = Vec::new();
-        for (r, run) in runs.iter_mut().enumerate() {
-            if r != last {
+        let runs: Vec<&[u32]> =
+            tail.chunk_by(|&a, &b| edge_ends_max(w, a as usize) == edge_ends_max(w, b as usize)).collect();
+        for (r, run) in runs.iter().enumerate() {
+            let mut run = run.to_vec();
+            if r + 1 != runs.len() {
                 run.sort_unstable_by_key(|&e| e / 3);
             }
-            pair_run(w, run.iter().copied(), &mut out);
+            pair_run(w, &run, &mut nb);
         }
-        tail.clear();
-        for (a, b) in out {
-            nb[a as usize] = b / 3;
-            nb[b as usize] = a / 3;
-        }
-    }
-    for (a, b) in pairs {
-        nb[a as usize] = b / 3;
-        nb[b as usize] = a / 3;
     }
     nb
+}
+
+#[inline]
+fn i0_of(w: &[u32], e: usize) -> u32 {
+    let (a, b) = edge_ends(w, e);
+    a.min(b)
+}
+
+/// Pairs the edges of one `i0` bucket (given in triangle order): runs of equal `i1`.
+fn pair_bucket(w: &[u32], bucket: &[u32], scratch: &mut Vec<(u32, u32)>, nb: &mut [u32]) {
+    match bucket.len() {
+        0 | 1 => {}
+        2 => {
+            if edge_ends_max(w, bucket[0] as usize) == edge_ends_max(w, bucket[1] as usize) {
+                pair_run(w, bucket, nb);
+            }
+        }
+        _ => {
+            scratch.clear();
+            scratch.extend(bucket.iter().map(|&e| (edge_ends_max(w, e as usize), e)));
+            // (i1, edge) order is (i1, triangle) order: one edge per triangle and key.
+            scratch.sort_unstable();
+            let mut run: Vec<u32> = Vec::new();
+            for r in scratch.chunk_by(|a, b| a.0 == b.0) {
+                if r.len() >= 2 {
+                    run.clear();
+                    run.extend(r.iter().map(|x| x.1));
+                    pair_run(w, &run, nb);
+                }
+            }
+        }
+    }
 }
 
 #[inline]
@@ -115,40 +134,44 @@ fn edge_ends_max(w: &[u32], e: usize) -> u32 {
 /// Greedy pairing of one run of same-key edges in the given order: each free edge takes the
 /// first later free edge running the opposite way. A pointer per direction makes it linear
 /// (the taken edges after any position form a prefix of that direction's later edges).
-fn pair_run(w: &[u32], run: impl Iterator<Item = u32>, out: &mut Vec<(u32, u32)>) {
-    let run: Vec<u32> = run.collect();
-    if run.len() < 2 {
-        return;
-    }
+fn pair_run(w: &[u32], run: &[u32], nb: &mut [u32]) {
     let dir = |e: u32| {
         let (a, b) = edge_ends(w, e as usize);
         (a > b) as usize
     };
-    if run.len() == 2 {
-        if dir(run[0]) != dir(run[1]) {
-            out.push((run[0], run[1]));
+    let mut link = |a: u32, b: u32| {
+        nb[a as usize] = b / 3;
+        nb[b as usize] = a / 3;
+    };
+    match run.len() {
+        0 | 1 => {}
+        2 => {
+            if dir(run[0]) != dir(run[1]) {
+                link(run[0], run[1]);
+            }
         }
-        return;
-    }
-    let mut lists: [Vec<usize>; 2] = [Vec::new(), Vec::new()];
-    for (i, &e) in run.iter().enumerate() {
-        lists[dir(e)].push(i);
-    }
-    let mut taken = vec![false; run.len()];
-    let mut ptr = [0usize; 2];
-    for i in 0..run.len() {
-        if taken[i] {
-            continue;
-        }
-        let d = 1 - dir(run[i]);
-        let l = &lists[d];
-        while ptr[d] < l.len() && (l[ptr[d]] <= i || taken[l[ptr[d]]]) {
-            ptr[d] += 1;
-        }
-        if let Some(&j) = l.get(ptr[d]) {
-            taken[i] = true;
-            taken[j] = true;
-            out.push((run[i], run[j]));
+        _ => {
+            let mut lists: [Vec<usize>; 2] = [Vec::new(), Vec::new()];
+            for (i, &e) in run.iter().enumerate() {
+                lists[dir(e)].push(i);
+            }
+            let mut taken = vec![false; run.len()];
+            let mut ptr = [0usize; 2];
+            for i in 0..run.len() {
+                if taken[i] {
+                    continue;
+                }
+                let d = 1 - dir(run[i]);
+                let l = &lists[d];
+                while ptr[d] < l.len() && (l[ptr[d]] <= i || taken[l[ptr[d]]]) {
+                    ptr[d] += 1;
+                }
+                if let Some(&j) = l.get(ptr[d]) {
+                    taken[i] = true;
+                    taken[j] = true;
+                    link(run[i], run[j]);
+                }
+            }
         }
     }
 }

@@ -21,11 +21,10 @@ struct Tmp {
     p: V3,
     /// Input corner id (`3 * face + corner`) of this list entry.
     id: u32,
-    /// List position (`3 * internal triangle + corner`).
-    k: u32,
-    /// Input corner id of the representative.
-    rep: u32,
 }
+
+/// No representative found (yet): the entry represents itself.
+const SELF: u32 = u32::MAX;
 
 const GROUPS: usize = 2048;
 const CHUNK: usize = 1 << 15;
@@ -94,39 +93,58 @@ pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
         start[g + 1] += start[g];
     }
     let mut cursor = start.clone();
-    let mut buf = vec![Tmp { p: [0.0; 3], id: 0, k: 0, rep: 0 }; n];
+    let mut buf = vec![Tmp { p: [0.0; 3], id: 0 }; n];
     for (k, &b) in buckets.iter().enumerate() {
         let id = id_of(k);
         let slot = &mut cursor[b as usize];
-        buf[*slot] = Tmp { p: c.pos(id as usize), id, k: k as u32, rep: id };
+        buf[*slot] = Tmp { p: c.pos(id as usize), id };
         *slot += 1;
     }
     drop(buckets);
+    // Representatives, aligned with the final (partitioned) buffer positions.
+    let mut reps = vec![SELF; n];
     let mut slices = Vec::with_capacity(GROUPS);
-    let mut rest = buf.as_mut_slice();
+    let (mut rest, mut rest_r) = (buf.as_mut_slice(), reps.as_mut_slice());
     for g in 0..GROUPS {
-        let (head, tail) = rest.split_at_mut(start[g + 1] - start[g]);
-        if head.len() >= 2 {
-            slices.push(head);
+        let len = start[g + 1] - start[g];
+        let (head, tail) = rest.split_at_mut(len);
+        let (head_r, tail_r) = rest_r.split_at_mut(len);
+        if len >= 2 {
+            slices.push((head, head_r));
         }
         rest = tail;
+        rest_r = tail_r;
     }
-    slices.into_par_iter().with_max_len(1).for_each(|s| merge(c, s));
-    for t in &buf {
-        welded[t.k as usize] = t.rep;
+    slices.into_par_iter().with_max_len(1).for_each(|(s, r)| merge(c, s, r));
+    // List position of an input corner id: the inverse of `id_of`.
+    let mut pos_of_face = vec![0u32; order.len()];
+    for (t, &f) in order.iter().enumerate() {
+        pos_of_face[f as usize] = t as u32;
+    }
+    for (t, &r) in buf.iter().zip(&reps) {
+        if r != SELF {
+            let k = 3 * pos_of_face[(t.id / 3) as usize] as usize + (t.id % 3) as usize;
+            welded[k] = r;
+        }
     }
     welded
 }
 
-/// `merge_verts_fast` of the reference with an explicit stack.
-fn merge(c: &Corners, buf: &mut [Tmp]) {
-    let mut stack = vec![(0usize, buf.len())];
-    while let Some((lo, hi)) = stack.pop() {
+type BBox = Option<(V3, V3)>;
+
+/// `merge_verts_fast` of the reference with an explicit stack. Each cell's bounding box is
+/// gathered while its parent is partitioned (min/max ignore NaN and the order of folding; the
+/// sign of a zero bound can differ but never changes a comparison the reference makes).
+fn merge(c: &Corners, buf: &mut [Tmp], reps: &mut [u32]) {
+    let bbox = buf.iter().fold(None, |acc, t| fold_bbox(acc, t.p));
+    let mut stack = vec![(0usize, buf.len(), bbox)];
+    let mut attrs: Vec<([f32; 3], [f32; 2])> = Vec::new();
+    while let Some((lo, hi, bbox)) = stack.pop() {
         let b = &mut buf[lo..hi];
         if b.len() < 2 {
             continue;
         }
-        let Some((mn, mx)) = b.iter().fold(None, |acc, t| fold_bbox(acc, t.p)) else {
+        let Some((mn, mx)) = bbox else {
             continue;
         };
         let d = [mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]];
@@ -137,18 +155,21 @@ fn merge(c: &Corners, buf: &mut [Tmp]) {
             continue;
         }
         if !(mn[ax] < sep && sep < mx[ax]) {
-            leaf(c, b);
+            leaf(c, b, &mut reps[lo..hi], &mut attrs);
             continue;
         }
-        let part = partition(b, ax, sep);
-        stack.push((lo + part, hi));
-        stack.push((lo, lo + part));
+        let (part, left, right) = partition(b, ax, sep);
+        stack.push((lo + part, hi, right));
+        stack.push((lo, lo + part, left));
     }
 }
 
 /// The reference's pairwise-swap partition, step for step (NaN coordinates are neither
-/// `>= sep` nor `< sep` and stay where the scans leave them).
-fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> usize {
+/// `>= sep` nor `< sep` and stay where the scans leave them). Returns the split point and the
+/// bounding boxes of both sides: everything the forward scan passes ends up left, everything
+/// the backward scan passes ends up right, and each swapped pair changes sides.
+fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
+    let (mut left, mut right): (BBox, BBox) = (None, None);
     let (mut start, mut end) = (0usize, b.len());
     while end - start >= 2 {
         let mut a = None;
@@ -159,6 +180,7 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> usize {
                 a = Some(i);
                 break;
             }
+            left = fold_bbox(left, b[i].p);
         }
         let mut z = None;
         while start < end {
@@ -167,10 +189,13 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> usize {
                 z = Some(end);
                 break;
             }
+            right = fold_bbox(right, b[end].p);
         }
         match (a, z) {
             (Some(a), Some(z)) => {
                 b.swap(a, z);
+                left = fold_bbox(left, b[a].p);
+                right = fold_bbox(right, b[z].p);
                 start = a + 1;
                 end = z;
             }
@@ -182,24 +207,30 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> usize {
             (None, None) => {}
         }
     }
-    if start < end && b[start].p[ax] < sep {
-        start + 1
-    } else {
-        start
+    let part = if start < end && b[start].p[ax] < sep { start + 1 } else { start };
+    // At most one element is left between the scans; it sits on the side `part` gives it.
+    for i in start..end {
+        if i < part {
+            left = fold_bbox(left, b[i].p);
+        } else {
+            right = fold_bbox(right, b[i].p);
+        }
     }
+    (part, left, right)
 }
 
 const SMALL_LEAF: usize = 24;
 
 /// Welds every corner of a leaf onto the first equal corner in leaf order.
-fn leaf(c: &Corners, b: &mut [Tmp]) {
+fn leaf(c: &Corners, b: &[Tmp], reps: &mut [u32], attrs: &mut Vec<([f32; 3], [f32; 2])>) {
+    attrs.clear();
+    attrs.extend(b.iter().map(|t| (c.nrm(t.id as usize), c.uv(t.id as usize))));
     if b.len() <= SMALL_LEAF {
         for l in 1..b.len() {
-            let (pa, na, ua) = (b[l].p, c.nrm(b[l].id as usize), c.uv(b[l].id as usize));
+            let (pa, (na, ua)) = (b[l].p, attrs[l]);
             for m in 0..l {
-                let id = b[m].id as usize;
-                if eq3(pa, b[m].p) && eq3(na, c.nrm(id)) && ua == c.uv(id) {
-                    b[l].rep = b[m].rep;
+                if eq3(pa, b[m].p) && eq3(na, attrs[m].0) && ua == attrs[m].1 {
+                    reps[l] = if reps[m] == SELF { b[m].id } else { reps[m] };
                     break;
                 }
             }
@@ -207,13 +238,15 @@ fn leaf(c: &Corners, b: &mut [Tmp]) {
         return;
     }
     let mut first: HashMap<[u32; 8], u32> = HashMap::with_capacity(b.len());
-    for t in b.iter_mut() {
-        let (n, u) = (c.nrm(t.id as usize), c.uv(t.id as usize));
+    for (l, t) in b.iter().enumerate() {
+        let (n, u) = attrs[l];
         let all = [t.p[0], t.p[1], t.p[2], n[0], n[1], n[2], u[0], u[1]];
         if all.iter().any(|x| x.is_nan()) {
             continue; // never equal to anything, never a representative of another
         }
-        let key = all.map(canon_bits);
-        t.rep = *first.entry(key).or_insert(t.rep);
+        let r = *first.entry(all.map(canon_bits)).or_insert(t.id);
+        if r != t.id {
+            reps[l] = r;
+        }
     }
 }
