@@ -7,9 +7,9 @@ use super::TriMesh;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Engine {
     /// `bevy_mikktspace`: a safe, byte-identical port of the C reference.
-    #[default]
     Bevy,
     /// [`super::fast`]: the same frames bit for bit, in linear time and on all cores.
+    #[default]
     Fast,
 }
 

@@ -19,8 +19,8 @@ use std::collections::HashMap;
 #[derive(Clone, Copy)]
 struct Tmp {
     p: V3,
-    /// Input corner id (`3 * face + corner`) of this list entry.
-    id: u32,
+    /// List position (`3 * internal triangle + corner`) of this entry.
+    k: u32,
 }
 
 /// No representative found (yet): the entry represents itself.
@@ -29,13 +29,44 @@ const SELF: u32 = u32::MAX;
 const GROUPS: usize = 2048;
 const CHUNK: usize = 1 << 15;
 
-fn fold_bbox(acc: Option<(V3, V3)>, v: V3) -> Option<(V3, V3)> {
-    let (mut mn, mut mx) = acc.unwrap_or((v, v));
-    for c in 0..3 {
-        mn[c] = mn[c].min(v[c]);
-        mx[c] = mx[c].max(v[c]);
+/// A bounding box that ignores NaN like the reference's `f32::min`/`max` fold, with one
+/// compare-and-select per bound. Empty components (no non-NaN value) read back as NaN, as in the
+/// reference. (The sign of a zero bound may differ; no comparison the reference makes can see
+/// it.)
+#[derive(Clone, Copy)]
+struct BBox {
+    mn: V3,
+    mx: V3,
+}
+
+const EMPTY: BBox = BBox { mn: [f32::INFINITY; 3], mx: [f32::NEG_INFINITY; 3] };
+
+impl BBox {
+    #[inline]
+    fn grow(&mut self, p: V3) {
+        for c in 0..3 {
+            self.mn[c] = if p[c] < self.mn[c] { p[c] } else { self.mn[c] };
+            self.mx[c] = if p[c] > self.mx[c] { p[c] } else { self.mx[c] };
+        }
     }
-    Some((mn, mx))
+    #[inline]
+    fn union(mut self, o: BBox) -> BBox {
+        for c in 0..3 {
+            self.mn[c] = if o.mn[c] < self.mn[c] { o.mn[c] } else { self.mn[c] };
+            self.mx[c] = if o.mx[c] > self.mx[c] { o.mx[c] } else { self.mx[c] };
+        }
+        self
+    }
+    fn bounds(self) -> (V3, V3) {
+        let (mut mn, mut mx) = (self.mn, self.mx);
+        for c in 0..3 {
+            if mn[c] > mx[c] {
+                mn[c] = f32::NAN;
+                mx[c] = f32::NAN;
+            }
+        }
+        (mn, mx)
+    }
 }
 
 /// The reference's choice of the longest axis (ties and NaN resolve as in the reference).
@@ -54,31 +85,31 @@ fn longest_axis(d: V3) -> usize {
 pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
     let n = order.len() * 3;
     let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
+    // Positions in list order, gathered once.
+    let pos: Vec<V3> = (0..n).into_par_iter().with_min_len(1 << 12).map(|k| c.pos(id_of(k) as usize)).collect();
     // Bounding box in fixed chunks (same value as the reference's sequential fold; the chunking
     // does not depend on the thread count).
-    let bbox = (0..n.div_ceil(CHUNK))
-        .into_par_iter()
+    let bbox = pos
+        .par_chunks(CHUNK)
         .map(|ch| {
-            (ch * CHUNK..n.min((ch + 1) * CHUNK))
-                .fold(None, |acc, k| fold_bbox(acc, c.pos(id_of(k) as usize)))
+            let mut b = EMPTY;
+            ch.iter().for_each(|&p| b.grow(p));
+            b
         })
         .collect::<Vec<_>>()
         .into_iter()
-        .flatten()
-        .fold(None, |acc: Option<(V3, V3)>, (mn, mx)| {
-            let acc = fold_bbox(acc, mn);
-            fold_bbox(acc, mx)
-        });
-    let mut welded: Vec<u32> = (0..n).map(id_of).collect();
-    let Some((mn, mx)) = bbox else {
+        .fold(EMPTY, BBox::union);
+    let mut welded: Vec<u32> = (0..n).into_par_iter().with_min_len(1 << 12).map(id_of).collect();
+    if n == 0 {
         return welded;
-    };
+    }
+    let (mn, mx) = bbox.bounds();
     let d = [mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]];
     let cm = longest_axis(d);
-    let buckets: Vec<u16> = (0..n)
-        .into_par_iter()
-        .map(|k| {
-            let p = c.pos(id_of(k) as usize);
+    let buckets: Vec<u16> = pos
+        .par_iter()
+        .with_min_len(1 << 12)
+        .map(|p| {
             let t = (p[cm] - mn[cm]) / d[cm];
             let g = (GROUPS as f32 * t.clamp(0.0, 1.0)) as u16;
             g.min(GROUPS as u16 - 1)
@@ -93,14 +124,14 @@ pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
         start[g + 1] += start[g];
     }
     let mut cursor = start.clone();
-    let mut buf = vec![Tmp { p: [0.0; 3], id: 0 }; n];
-    for (k, &b) in buckets.iter().enumerate() {
-        let id = id_of(k);
+    let mut buf = vec![Tmp { p: [0.0; 3], k: 0 }; n];
+    for (k, (&b, &p)) in buckets.iter().zip(&pos).enumerate() {
         let slot = &mut cursor[b as usize];
-        buf[*slot] = Tmp { p: c.pos(id as usize), id };
+        buf[*slot] = Tmp { p, k: k as u32 };
         *slot += 1;
     }
     drop(buckets);
+    drop(pos);
     // Representatives, aligned with the final (partitioned) buffer positions.
     let mut reps = vec![SELF; n];
     let mut slices = Vec::with_capacity(GROUPS);
@@ -115,38 +146,30 @@ pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
         rest = tail;
         rest_r = tail_r;
     }
-    slices.into_par_iter().with_max_len(1).for_each(|(s, r)| merge(c, s, r));
-    // List position of an input corner id: the inverse of `id_of`.
-    let mut pos_of_face = vec![0u32; order.len()];
-    for (t, &f) in order.iter().enumerate() {
-        pos_of_face[f as usize] = t as u32;
-    }
+    slices.into_par_iter().with_max_len(1).for_each(|(s, r)| merge(c, order, s, r));
     for (t, &r) in buf.iter().zip(&reps) {
         if r != SELF {
-            let k = 3 * pos_of_face[(t.id / 3) as usize] as usize + (t.id % 3) as usize;
-            welded[k] = r;
+            welded[t.k as usize] = r;
         }
     }
     welded
 }
 
-type BBox = Option<(V3, V3)>;
 
 /// `merge_verts_fast` of the reference with an explicit stack. Each cell's bounding box is
 /// gathered while its parent is partitioned (min/max ignore NaN and the order of folding; the
 /// sign of a zero bound can differ but never changes a comparison the reference makes).
-fn merge(c: &Corners, buf: &mut [Tmp], reps: &mut [u32]) {
-    let bbox = buf.iter().fold(None, |acc, t| fold_bbox(acc, t.p));
+fn merge(c: &Corners, order: &[u32], buf: &mut [Tmp], reps: &mut [u32]) {
+    let mut bbox = EMPTY;
+    buf.iter().for_each(|t| bbox.grow(t.p));
     let mut stack = vec![(0usize, buf.len(), bbox)];
-    let mut attrs: Vec<([f32; 3], [f32; 2])> = Vec::new();
+    let mut attrs: Vec<(u32, [f32; 3], [f32; 2])> = Vec::new();
     while let Some((lo, hi, bbox)) = stack.pop() {
         let b = &mut buf[lo..hi];
         if b.len() < 2 {
             continue;
         }
-        let Some((mn, mx)) = bbox else {
-            continue;
-        };
+        let (mn, mx) = bbox.bounds();
         let d = [mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]];
         let ax = longest_axis(d);
         let sep = 0.5f32 * (mx[ax] + mn[ax]);
@@ -155,7 +178,7 @@ fn merge(c: &Corners, buf: &mut [Tmp], reps: &mut [u32]) {
             continue;
         }
         if !(mn[ax] < sep && sep < mx[ax]) {
-            leaf(c, b, &mut reps[lo..hi], &mut attrs);
+            leaf(c, order, b, &mut reps[lo..hi], &mut attrs);
             continue;
         }
         let (part, left, right) = partition(b, ax, sep);
@@ -169,7 +192,7 @@ fn merge(c: &Corners, buf: &mut [Tmp], reps: &mut [u32]) {
 /// bounding boxes of both sides: everything the forward scan passes ends up left, everything
 /// the backward scan passes ends up right, and each swapped pair changes sides.
 fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
-    let (mut left, mut right): (BBox, BBox) = (None, None);
+    let (mut left, mut right) = (EMPTY, EMPTY);
     let (mut start, mut end) = (0usize, b.len());
     while end - start >= 2 {
         let mut a = None;
@@ -180,7 +203,7 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
                 a = Some(i);
                 break;
             }
-            left = fold_bbox(left, b[i].p);
+            left.grow(b[i].p);
         }
         let mut z = None;
         while start < end {
@@ -189,13 +212,13 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
                 z = Some(end);
                 break;
             }
-            right = fold_bbox(right, b[end].p);
+            right.grow(b[end].p);
         }
         match (a, z) {
             (Some(a), Some(z)) => {
                 b.swap(a, z);
-                left = fold_bbox(left, b[a].p);
-                right = fold_bbox(right, b[z].p);
+                left.grow(b[a].p);
+                right.grow(b[z].p);
                 start = a + 1;
                 end = z;
             }
@@ -211,9 +234,9 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
     // At most one element is left between the scans; it sits on the side `part` gives it.
     for i in start..end {
         if i < part {
-            left = fold_bbox(left, b[i].p);
+            left.grow(b[i].p);
         } else {
-            right = fold_bbox(right, b[i].p);
+            right.grow(b[i].p);
         }
     }
     (part, left, right)
@@ -222,15 +245,18 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
 const SMALL_LEAF: usize = 24;
 
 /// Welds every corner of a leaf onto the first equal corner in leaf order.
-fn leaf(c: &Corners, b: &[Tmp], reps: &mut [u32], attrs: &mut Vec<([f32; 3], [f32; 2])>) {
+fn leaf(c: &Corners, order: &[u32], b: &[Tmp], reps: &mut [u32], attrs: &mut Vec<(u32, [f32; 3], [f32; 2])>) {
     attrs.clear();
-    attrs.extend(b.iter().map(|t| (c.nrm(t.id as usize), c.uv(t.id as usize))));
+    attrs.extend(b.iter().map(|t| {
+        let id = 3 * order[t.k as usize / 3] + t.k % 3;
+        (id, c.nrm(id as usize), c.uv(id as usize))
+    }));
     if b.len() <= SMALL_LEAF {
         for l in 1..b.len() {
-            let (pa, (na, ua)) = (b[l].p, attrs[l]);
+            let (pa, (_, na, ua)) = (b[l].p, attrs[l]);
             for m in 0..l {
-                if eq3(pa, b[m].p) && eq3(na, attrs[m].0) && ua == attrs[m].1 {
-                    reps[l] = if reps[m] == SELF { b[m].id } else { reps[m] };
+                if eq3(pa, b[m].p) && eq3(na, attrs[m].1) && ua == attrs[m].2 {
+                    reps[l] = if reps[m] == SELF { attrs[m].0 } else { reps[m] };
                     break;
                 }
             }
@@ -239,13 +265,13 @@ fn leaf(c: &Corners, b: &[Tmp], reps: &mut [u32], attrs: &mut Vec<([f32; 3], [f3
     }
     let mut first: HashMap<[u32; 8], u32> = HashMap::with_capacity(b.len());
     for (l, t) in b.iter().enumerate() {
-        let (n, u) = attrs[l];
+        let (id, n, u) = attrs[l];
         let all = [t.p[0], t.p[1], t.p[2], n[0], n[1], n[2], u[0], u[1]];
         if all.iter().any(|x| x.is_nan()) {
             continue; // never equal to anything, never a representative of another
         }
-        let r = *first.entry(all.map(canon_bits)).or_insert(t.id);
-        if r != t.id {
+        let r = *first.entry(all.map(canon_bits)).or_insert(id);
+        if r != id {
             reps[l] = r;
         }
     }
