@@ -33,49 +33,72 @@ pub(crate) fn build(w: &[u32], id_space: usize) -> Vec<u32> {
     if n_edges == 0 {
         return nb;
     }
-    let i0: Vec<u32> = (0..n_edges)
-        .into_par_iter()
-        .with_min_len(1 << 14)
-        .map(|e| {
-            let (a, b) = edge_ends(w, e);
-            a.min(b)
-        })
-        .collect();
-    let max_i0 = i0.par_iter().copied().max().unwrap_or(0);
-    // Counting sort of edges by i0 (stable: triangle order within an i0).
-    let mut start = vec![0u32; id_space + 1];
-    for &k in &i0 {
-        start[k as usize + 1] += 1;
-    }
-    let mut acc = 0u32;
-    for s in start.iter_mut() {
-        acc += *s;
-        *s = acc;
-    }
-    // start[i] is now the end of bucket i - 1, i.e. the start of bucket i.
-    let mut by_i0 = vec![0u32; n_edges];
-    {
-        let mut cursor = start;
-        for (e, &k) in i0.iter().enumerate() {
-            let c = &mut cursor[k as usize];
-            by_i0[*c as usize] = e as u32;
-            *c += 1;
-        }
-        start = cursor; // cursor[i] = end of bucket i
-    }
-    drop(i0);
-    let tail_lo = if max_i0 == 0 { 0 } else { start[max_i0 as usize - 1] as usize };
-    let tail_len = n_edges - tail_lo;
+    let max_i0 = (0..n_edges).into_par_iter().with_min_len(1 << 14).map(|e| i0_of(w, e)).max().unwrap_or(0);
+    let tail_len = (0..n_edges).into_par_iter().with_min_len(1 << 14).filter(|&e| i0_of(w, e) == max_i0).count();
     // Pair every i0 bucket except the quirky last one (when it needs the replay).
     let replay = tail_len >= 3;
-    let normal_end = if replay { tail_lo } else { n_edges };
-    let mut scratch: Vec<(u32, u32)> = Vec::new();
-    let mut lo = 0usize;
-    while lo < normal_end {
-        let k = i0_of(w, by_i0[lo] as usize);
-        let hi = (start[k as usize] as usize).min(normal_end);
-        pair_bucket(w, &by_i0[lo..hi], &mut scratch, &mut nb);
-        lo = hi;
+    // Edges go to ranges of i0 (chunk by chunk, keeping triangle order), then each range is
+    // counting-sorted by i0 and paired on its own: ranges never share a key.
+    const RANGES: usize = 256;
+    const CHUNK: usize = 1 << 16;
+    let shift = {
+        let mut s = 0u32;
+        while (id_space >> s) >= RANGES {
+            s += 1;
+        }
+        s
+    };
+    let per_chunk: Vec<Vec<Vec<u32>>> = (0..n_edges.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|ch| {
+            let mut v: Vec<Vec<u32>> = vec![Vec::new(); RANGES];
+            for e in ch * CHUNK..n_edges.min((ch + 1) * CHUNK) {
+                let k = i0_of(w, e);
+                if !(replay && k == max_i0) {
+                    v[(k >> shift) as usize].push(e as u32);
+                }
+            }
+            v
+        })
+        .collect();
+    let pairs: Vec<Vec<(u32, u32)>> = (0..RANGES)
+        .into_par_iter()
+        .map(|r| {
+            let edges: Vec<u32> = per_chunk.iter().flat_map(|c| c[r].iter().copied()).collect();
+            let mut out = Vec::with_capacity(edges.len() / 2);
+            if edges.len() < 2 {
+                return out;
+            }
+            let base = (r as u32) << shift;
+            let span = 1usize << shift;
+            // Counting sort by i0 within the range (stable).
+            let mut start = vec![0u32; span + 1];
+            for &e in &edges {
+                start[(i0_of(w, e as usize) - base) as usize + 1] += 1;
+            }
+            for i in 0..span {
+                start[i + 1] += start[i];
+            }
+            let mut sorted = vec![0u32; edges.len()];
+            for &e in &edges {
+                let c = &mut start[(i0_of(w, e as usize) - base) as usize];
+                sorted[*c as usize] = e;
+                *c += 1;
+            }
+            let mut scratch: Vec<(u32, u32)> = Vec::new();
+            for bucket in sorted.chunk_by(|&a, &b| i0_of(w, a as usize) == i0_of(w, b as usize)) {
+                pair_bucket(w, bucket, &mut scratch, &mut |a, b| out.push((a, b)));
+            }
+            out
+        })
+        .collect();
+    drop(per_chunk);
+    let mut link = |a: u32, b: u32| {
+        nb[a as usize] = b / 3;
+        nb[b as usize] = a / 3;
+    };
+    for (a, b) in pairs.into_iter().flatten() {
+        link(a, b);
     }
     if replay {
         let tail = legacy_tail(w, max_i0);
@@ -87,7 +110,7 @@ pub(crate) fn build(w: &[u32], id_space: usize) -> Vec<u32> {
             if r + 1 != runs.len() {
                 run.sort_unstable_by_key(|&e| e / 3);
             }
-            pair_run(w, &run, &mut nb);
+            pair_run(w, &run, &mut link);
         }
     }
     nb
@@ -100,12 +123,12 @@ fn i0_of(w: &[u32], e: usize) -> u32 {
 }
 
 /// Pairs the edges of one `i0` bucket (given in triangle order): runs of equal `i1`.
-fn pair_bucket(w: &[u32], bucket: &[u32], scratch: &mut Vec<(u32, u32)>, nb: &mut [u32]) {
+fn pair_bucket(w: &[u32], bucket: &[u32], scratch: &mut Vec<(u32, u32)>, link: &mut impl FnMut(u32, u32)) {
     match bucket.len() {
         0 | 1 => {}
         2 => {
             if edge_ends_max(w, bucket[0] as usize) == edge_ends_max(w, bucket[1] as usize) {
-                pair_run(w, bucket, nb);
+                pair_run(w, bucket, link);
             }
         }
         _ => {
@@ -118,7 +141,7 @@ fn pair_bucket(w: &[u32], bucket: &[u32], scratch: &mut Vec<(u32, u32)>, nb: &mu
                 if r.len() >= 2 {
                     run.clear();
                     run.extend(r.iter().map(|x| x.1));
-                    pair_run(w, &run, nb);
+                    pair_run(w, &run, link);
                 }
             }
         }
@@ -134,14 +157,10 @@ fn edge_ends_max(w: &[u32], e: usize) -> u32 {
 /// Greedy pairing of one run of same-key edges in the given order: each free edge takes the
 /// first later free edge running the opposite way. A pointer per direction makes it linear
 /// (the taken edges after any position form a prefix of that direction's later edges).
-fn pair_run(w: &[u32], run: &[u32], nb: &mut [u32]) {
+fn pair_run(w: &[u32], run: &[u32], link: &mut impl FnMut(u32, u32)) {
     let dir = |e: u32| {
         let (a, b) = edge_ends(w, e as usize);
         (a > b) as usize
-    };
-    let mut link = |a: u32, b: u32| {
-        nb[a as usize] = b / 3;
-        nb[b as usize] = a / 3;
     };
     match run.len() {
         0 | 1 => {}
