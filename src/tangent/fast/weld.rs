@@ -106,50 +106,59 @@ pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
     let (mn, mx) = bbox.bounds();
     let d = [mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]];
     let cm = longest_axis(d);
-    let buckets: Vec<u16> = pos
-        .par_iter()
-        .with_min_len(1 << 12)
-        .map(|p| {
-            let t = (p[cm] - mn[cm]) / d[cm];
-            let g = (GROUPS as f32 * t.clamp(0.0, 1.0)) as u16;
-            g.min(GROUPS as u16 - 1)
+    let bucket_of = |p: &V3| {
+        let t = (p[cm] - mn[cm]) / d[cm];
+        let g = (GROUPS as f32 * t.clamp(0.0, 1.0)) as u16;
+        g.min(GROUPS as u16 - 1) as usize
+    };
+    // Stable counting sort by bucket (the reference's `sort_by_key`), in parallel: each chunk of
+    // the list sorts itself by bucket, then each bucket concatenates its segments chunk by chunk.
+    let chunks: Vec<(Vec<Tmp>, Vec<u32>)> = pos
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(ci, ch)| {
+            let mut start = vec![0u32; GROUPS + 1];
+            let bs: Vec<u16> = ch.iter().map(|p| bucket_of(p) as u16).collect();
+            for &b in &bs {
+                start[b as usize + 1] += 1;
+            }
+            for g in 0..GROUPS {
+                start[g + 1] += start[g];
+            }
+            let mut cursor = start.clone();
+            let mut out = vec![Tmp { p: [0.0; 3], k: 0 }; ch.len()];
+            for (i, (&b, &p)) in bs.iter().zip(ch).enumerate() {
+                let slot = &mut cursor[b as usize];
+                out[*slot as usize] = Tmp { p, k: (ci * CHUNK + i) as u32 };
+                *slot += 1;
+            }
+            (out, start)
         })
         .collect();
-    // Stable counting sort by bucket (the reference's `sort_by_key`).
-    let mut start = vec![0usize; GROUPS + 1];
-    for &b in &buckets {
-        start[b as usize + 1] += 1;
-    }
-    for g in 0..GROUPS {
-        start[g + 1] += start[g];
-    }
-    let mut cursor = start.clone();
-    let mut buf = vec![Tmp { p: [0.0; 3], k: 0 }; n];
-    for (k, (&b, &p)) in buckets.iter().zip(&pos).enumerate() {
-        let slot = &mut cursor[b as usize];
-        buf[*slot] = Tmp { p, k: k as u32 };
-        *slot += 1;
-    }
-    drop(buckets);
     drop(pos);
-    // Representatives, aligned with the final (partitioned) buffer positions.
-    let mut reps = vec![SELF; n];
-    let mut slices = Vec::with_capacity(GROUPS);
-    let (mut rest, mut rest_r) = (buf.as_mut_slice(), reps.as_mut_slice());
-    for g in 0..GROUPS {
-        let len = start[g + 1] - start[g];
-        let (head, tail) = rest.split_at_mut(len);
-        let (head_r, tail_r) = rest_r.split_at_mut(len);
-        if len >= 2 {
-            slices.push((head, head_r));
-        }
-        rest = tail;
-        rest_r = tail_r;
-    }
-    slices.into_par_iter().with_max_len(1).for_each(|(s, r)| merge(c, order, s, r));
-    for (t, &r) in buf.iter().zip(&reps) {
-        if r != SELF {
-            welded[t.k as usize] = r;
+    let results: Vec<(Vec<Tmp>, Vec<u32>)> = (0..GROUPS)
+        .into_par_iter()
+        .with_max_len(1)
+        .filter_map(|g| {
+            let len: usize = chunks.iter().map(|(_, st)| (st[g + 1] - st[g]) as usize).sum();
+            if len < 2 {
+                return None;
+            }
+            let mut buf = Vec::with_capacity(len);
+            for (out, st) in &chunks {
+                buf.extend_from_slice(&out[st[g] as usize..st[g + 1] as usize]);
+            }
+            // Representatives, aligned with the final (partitioned) buffer positions.
+            let mut reps = vec![SELF; len];
+            merge(c, order, &mut buf, &mut reps);
+            Some((buf, reps))
+        })
+        .collect();
+    for (buf, reps) in &results {
+        for (t, &r) in buf.iter().zip(reps) {
+            if r != SELF {
+                welded[t.k as usize] = r;
+            }
         }
     }
     welded
