@@ -258,12 +258,14 @@ pub fn error_vs(out: &[Option<[f32; 4]>], reference: &[Option<[f32; 4]>]) -> (Er
     for (o, r) in out.iter().zip(reference) {
         match (o, r) {
             (Some(a), Some(b)) => {
-                errs.push(angle_deg([a[0], a[1], a[2]], [b[0], b[1], b[2]]));
-                if a[3] != b[3] {
-                    sign += 1;
-                }
                 if a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()) {
                     identical += 1;
+                    errs.push(0.0);
+                } else {
+                    errs.push(angle_deg([a[0], a[1], a[2]], [b[0], b[1], b[2]]));
+                }
+                if a[3] != b[3] {
+                    sign += 1;
                 }
             }
             (None, None) => identical += 1,
