@@ -48,3 +48,37 @@ fn cube_matches_reference() {
     let b = gen(&m, Engine::Bevy);
     assert!(same(&a, &b), "{a:?}\n{b:?}");
 }
+
+#[test]
+fn invalid_and_empty_inputs_do_not_panic() {
+    let p = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let n = [[0.0f32, 0.0, 1.0]; 3];
+    let uv = [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    let bad = [0u32, 1, 7];
+    let m = TriMesh { positions: &p, normals: &n, uvs: &uv, indices: &bad };
+    assert_eq!(gen(&m, Engine::Fast), vec![None; 3]);
+    let empty = TriMesh { positions: &p, normals: &n, uvs: &uv, indices: &[] };
+    assert!(gen(&empty, Engine::Fast).is_empty());
+    // A trailing partial triangle gets no frame, as with the reference wrapper.
+    let partial = [0u32, 1, 2, 0];
+    let m = TriMesh { positions: &p, normals: &n, uvs: &uv, indices: &partial };
+    let a = gen(&m, Engine::Fast);
+    assert!(same(&a, &gen(&m, Engine::Bevy)));
+    assert_eq!(a[3], None);
+    // Non-finite everything: no panic, and the reference's answer.
+    let pw = [[f32::NAN, f32::INFINITY, 0.0], [f32::NEG_INFINITY, 0.0, f32::NAN], [3e38, -3e38, 1e-40]];
+    let nw = [[f32::NAN; 3], [f32::INFINITY, 0.0, 0.0], [0.0; 3]];
+    let uw = [[f32::NAN, 0.0], [f32::INFINITY, 1.0], [1e-40, -0.0]];
+    let idx = [0u32, 1, 2, 2, 1, 0, 0, 0, 1];
+    let m = TriMesh { positions: &pw, normals: &nw, uvs: &uw, indices: &idx };
+    let a = gen(&m, Engine::Fast);
+    let b = gen(&m, Engine::Bevy);
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        match (x, y) {
+            (Some(x), Some(y)) => assert!(x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits() || (p.is_nan() && q.is_nan()))),
+            (None, None) => {}
+            _ => panic!("{x:?} vs {y:?}"),
+        }
+    }
+}
