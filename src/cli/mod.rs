@@ -2,6 +2,8 @@
 
 mod bake;
 mod bench;
+mod bench_normalmap;
+mod bench_tangents;
 mod completions;
 mod inspect;
 mod normalmap;

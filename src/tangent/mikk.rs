@@ -7,8 +7,10 @@ use super::TriMesh;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Engine {
     /// `bevy_mikktspace`: a safe, byte-identical port of the C reference.
-    #[default]
     Bevy,
+    /// [`super::fast`]: the same frames bit for bit, in linear time and on all cores.
+    #[default]
+    Fast,
 }
 
 /// Per-corner MikkTSpace frames `(t.x, t.y, t.z, sign)` in the reference's own sign convention
@@ -17,6 +19,13 @@ pub enum Engine {
 pub fn generate(mesh: &TriMesh, engine: Engine) -> Vec<Option<[f32; 4]>> {
     match engine {
         Engine::Bevy => generate_bevy(mesh),
+        Engine::Fast => match super::fast::generate(mesh) {
+            Ok(out) => out,
+            // Beyond 32-bit corner ids: the reference has no such limit.
+            Err(super::fast::Unsupported::TooLarge) => generate_bevy(mesh),
+            // An index past an attribute array: no frame is defined (the reference panics).
+            Err(super::fast::Unsupported::IndexOutOfRange) => vec![None; mesh.indices.len()],
+        },
     }
 }
 

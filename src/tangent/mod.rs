@@ -6,6 +6,7 @@
 pub mod apply;
 pub mod command;
 pub mod fallback;
+pub mod fast;
 pub mod mikk;
 
 use crate::scene::weld::{unweld, weld};
