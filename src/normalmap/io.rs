@@ -38,10 +38,12 @@ pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
     let mut limits = Limits::no_limits();
     limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 24));
     reader.limits(limits);
-    let what = format!(
-        "cannot decode as {:?}",
-        reader.format().expect("checked above")
-    );
+    let what = match reader.format() {
+        Some(image::ImageFormat::Png) => "cannot decode as PNG".to_string(),
+        Some(image::ImageFormat::Tiff) => "cannot decode as TIFF".to_string(),
+        Some(image::ImageFormat::OpenExr) => "cannot decode as EXR".to_string(),
+        other => format!("cannot decode as {other:?}"),
+    };
     let decoder = reader
         .into_decoder()
         .map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
