@@ -467,3 +467,26 @@ fn help_ends_with_examples() {
     let tail: Vec<&str> = text.trim_end().lines().rev().take(4).collect();
     assert!(tail.iter().filter(|l| l.trim_start().starts_with("bumpbake normalmap")).count() >= 3, "{text}");
 }
+
+#[test]
+fn streamed_png_matches_the_in_memory_encoder_across_strips() {
+    // 1500 rows of width 5 make two strips (strips hold at most 1024 rows).
+    use bumpbake::normalmap as nm;
+    let d = Dir::new();
+    let (w, h) = (5u32, 1500u32);
+    let input = d.path("tall.png");
+    gray16(&input, w, h, noise);
+    let plane = nm::load_height(&input, nm::Channel::Luma, nm::DEFAULT_MAX_PIXELS).unwrap();
+    for (bits, depth) in [("8", nm::Depth::Bits8), ("16", nm::Depth::Bits16)] {
+        for f in ["sobel", "spectral"] {
+            let out = d.path("n.png");
+            ok(&["normalmap", p(&input), "-o", p(&out), "--bits", bits, "--filter", f, "--alpha", "height", "--strength", "3"]);
+            let filter = if f == "sobel" { nm::Filter::Sobel } else { nm::Filter::Spectral };
+            let opts = nm::Options { strength: 3.0, filter, ..Default::default() };
+            let enc = nm::EncodeOptions { depth, alpha_height: true, ..Default::default() };
+            let want = nm::encode_normals(&plane, &opts, &enc, None);
+            let got = nm::load_normal_image(&out, nm::DEFAULT_MAX_PIXELS).unwrap();
+            assert_eq!(got, want, "{bits}-bit {f}");
+        }
+    }
+}
