@@ -1,5 +1,6 @@
 //! `bumpbake normalmap` end to end: inputs are made here, the binary is run, and the written
 //! files are checked against answers worked out independently (in f64, from the conventions).
+#![allow(clippy::needless_range_loop)]
 
 use image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgb32FImage};
 use std::path::{Path, PathBuf};

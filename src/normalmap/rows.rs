@@ -28,6 +28,7 @@ const LIM: f32 = 1e15;
 /// [`unit_normal`] over a row into three planes, `n.y` times `ysign`: a loop of independent
 /// lanes that compiles to packed SSE (min/max, sqrt, div), unlike the interleaved form.
 #[inline(always)]
+#[allow(clippy::manual_clamp)]
 pub(crate) fn unit_normals_planar(gx: &[f32], gy: &[f32], s: f32, ysign: f32, n: &mut [Vec<f32>; 3]) {
     let w = gx.len();
     let [nx, ny, nz] = n;

@@ -12,6 +12,9 @@
 //! seam to ring, and a ramp is differentiated exactly. What remains at the edges is the corner
 //! where the residual's slope changes sign; its ringing falls off within a few texels.
 
+// Lines are indexed from both ends (mirror extension, bottom-up columns): index loops read best.
+#![allow(clippy::needless_range_loop)]
+
 use super::Wrap;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex32;
