@@ -491,3 +491,18 @@ fn streamed_png_matches_the_in_memory_encoder_across_strips() {
         }
     }
 }
+
+#[test]
+fn tiff_and_png_inputs_and_outputs_agree() {
+    let d = Dir::new();
+    let (png_in, tif_in) = (d.path("h.png"), d.path("h.tif"));
+    gray16(&png_in, 17, 9, noise);
+    gray16(&tif_in, 17, 9, noise);
+    let (a, b, c) = (d.path("a.png"), d.path("b.png"), d.path("c.tif"));
+    ok(&["normalmap", p(&png_in), "-o", p(&a), "--bits", "16", "--strength", "2"]);
+    ok(&["normalmap", p(&tif_in), "-o", p(&b), "--bits", "16", "--strength", "2"]);
+    ok(&["normalmap", p(&png_in), "-o", p(&c), "--bits", "16", "--strength", "2"]);
+    let (a, b, c) = (read_rgb16(&a), read_rgb16(&b), image::open(&c).unwrap().into_rgb16());
+    assert_eq!(a, b);
+    assert_eq!(a, c);
+}
