@@ -4,7 +4,7 @@
 use super::normalmap::Report;
 use std::fmt::Write;
 
-const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"];
+const COLOURS: [&str; 8] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf", "#7f7f7f"];
 
 /// Mean angular error (degrees) against single-thread time per pixel (ns), one point per filter
 /// and surface, coloured by surface and labelled by filter.

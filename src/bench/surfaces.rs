@@ -27,6 +27,8 @@ pub struct Surface {
     waves: Vec<Wave>,
     /// Gaussian bump of this sigma (texels) at the centre, height 1.
     bump: Option<f64>,
+    /// Heights rounded to this many steps (255: an 8-bit file), as a real map would be.
+    levels: Option<f64>,
 }
 
 impl Surface {
@@ -53,7 +55,13 @@ impl Surface {
     /// The sampled heights as f32 (no quantisation: the filters' own error is measured).
     pub fn plane(&self) -> HeightPlane {
         let n = self.n;
-        HeightPlane::from_fn(n, n, |x, row| self.height_grad(x as f64, (n - 1 - row) as f64).0 as f32)
+        HeightPlane::from_fn(n, n, |x, row| {
+            let h = self.height_grad(x as f64, (n - 1 - row) as f64).0;
+            match self.levels {
+                Some(l) => ((h * l).round() / l) as f32,
+                None => h as f32,
+            }
+        })
     }
 
     /// Exact unit normals, row-major from the top row, OpenGL convention.
@@ -98,6 +106,7 @@ fn sine(name: &'static str, n: usize, cycles: f64) -> Surface {
         base: 0.5,
         waves: vec![Wave { amp: 0.5, p, q, phase: 0.3 }],
         bump: None,
+        levels: None,
     }
     .tuned()
 }
@@ -141,6 +150,7 @@ fn fractal(n: usize) -> Surface {
         base: 0.5,
         waves,
         bump: None,
+        levels: None,
     }
     .tuned()
 }
@@ -160,8 +170,11 @@ pub fn all(n: usize) -> Vec<Surface> {
             base: 0.0,
             waves: vec![],
             bump: Some(sigma),
+            levels: None,
         }
         .tuned(),
         fractal(n),
+        Surface { name: "fractal-16bit", what: "the fractal stored in 16 bits".into(), levels: Some(65535.0), ..fractal(n) },
+        Surface { name: "fractal-8bit", what: "the fractal stored in 8 bits (terracing)".into(), levels: Some(255.0), ..fractal(n) },
     ]
 }

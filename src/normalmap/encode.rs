@@ -186,16 +186,38 @@ fn fused<T: Copy + Send + Sync + Default>(
     q: impl Fn(f32) -> T + Sync + Copy,
     qa: impl Fn(f32) -> T + Sync + Copy,
 ) {
-    let (w, h, ch) = (height.width, height.height, channels(enc));
+    if height.width == 0 || height.height == 0 {
+        out.clear();
+        return;
+    }
+    let rows = rows::Rows::new(height, opts);
+    fused_rows(&rows, height, opts, enc, 0, height.height, progress, out, q, qa);
+}
+
+/// Rows `y0..y0 + n` of the encoded map into `out` (resized to fit).
+#[allow(clippy::too_many_arguments)]
+fn fused_rows<T: Copy + Send + Sync + Default>(
+    rows: &rows::Rows,
+    height: &HeightPlane,
+    opts: &Options,
+    enc: &EncodeOptions,
+    y0: usize,
+    n: usize,
+    progress: Progress,
+    out: &mut Vec<T>,
+    q: impl Fn(f32) -> T + Sync + Copy,
+    qa: impl Fn(f32) -> T + Sync + Copy,
+) {
+    let (w, ch) = (height.width, channels(enc));
     let (s, ysign, invert) = (opts.signed_strength(), enc.convention.y_sign(), opts.invert);
     let zero = T::default();
-    out.resize(w * h * ch, zero);
+    out.resize(w * n * ch, zero);
     let state = || {
         let n: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0.0f32; w]);
         let c: [Vec<T>; 4] = std::array::from_fn(|_| vec![zero; w]);
         (n, c)
     };
-    rows::for_each_row(height, opts, out, w * ch, progress, state, |y, x0, gx, gy, row, (n, c)| {
+    rows.run(y0, out, w * ch, progress, state, |y, x0, gx, gy, row, (n, c)| {
         let len = gx.len();
         rows::unit_normals_planar(gx, gy, s, ysign, n);
         for k in 0..3 {
@@ -217,6 +239,32 @@ fn fused<T: Copy + Send + Sync + Default>(
             }
         }
     });
+}
+
+/// Filters and encodes a map strip by strip into a reused buffer, for writers that stream
+/// (PNG): the whole encoded map never exists, and the strip buffer's pages are touched once.
+pub(crate) struct Strips<'a> {
+    rows: rows::Rows<'a>,
+    height: &'a HeightPlane,
+    opts: Options,
+    enc: EncodeOptions,
+    pub u8s: Vec<u8>,
+    pub u16s: Vec<u16>,
+}
+
+impl<'a> Strips<'a> {
+    pub fn new(height: &'a HeightPlane, opts: &Options, enc: &EncodeOptions) -> Strips<'a> {
+        Strips { rows: rows::Rows::new(height, opts), height, opts: *opts, enc: *enc, u8s: Vec::new(), u16s: Vec::new() }
+    }
+    /// Encodes rows `y0..y0 + n` into `u8s` (8-bit) or `u16s` (16-bit).
+    pub fn encode(&mut self, y0: usize, n: usize, progress: Progress) {
+        let (r, h, o, e) = (&self.rows, self.height, &self.opts, &self.enc);
+        match e.depth {
+            Depth::Bits8 => fused_rows(r, h, o, e, y0, n, progress, &mut self.u8s, quantize8, alpha8),
+            Depth::Bits16 => fused_rows(r, h, o, e, y0, n, progress, &mut self.u16s, quantize16, alpha16),
+            Depth::Float => unreachable!("float maps are not streamed"),
+        }
+    }
 }
 
 /// Encodes float normals (OpenGL convention, as [`NormalPlane`] holds them). `heights` fills

@@ -54,6 +54,7 @@ impl RowScratch {
 impl<const R: usize> Kernel<R> {
     /// Computes `dh/dx` and `dh/dy_up` for image row `y` of a `width`-wide plane.
     #[cfg(test)]
+    #[allow(clippy::too_many_arguments)]
     pub fn row(
         &self,
         plane: &[f32],

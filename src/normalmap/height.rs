@@ -56,28 +56,53 @@ impl HeightPlane {
 const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
 #[derive(Clone, Copy)]
-enum Pick {
+pub(crate) enum Pick {
     Index(usize),
     Luma,
 }
 
-/// Turns a decoded image into heights. The error says what is wrong, without the file name.
-pub fn height_from_image(img: &DynamicImage, channel: Channel) -> Result<HeightPlane, String> {
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    let has_alpha = img.color().has_alpha();
-    let is_colour = img.color().has_color();
-    let channels = img.color().channel_count() as usize;
-    let pick = match channel {
-        Channel::A if !has_alpha => {
-            return Err("--channel a, but the image has no alpha channel".into())
-        }
+/// Which sample of a `channels`-sample pixel holds the height, or why none does.
+pub(crate) fn pick(channel: Channel, channels: usize, has_alpha: bool, is_colour: bool) -> Result<Pick, String> {
+    Ok(match channel {
+        Channel::A if !has_alpha => return Err("--channel a, but the image has no alpha channel".into()),
         Channel::A => Pick::Index(channels - 1),
         _ if !is_colour => Pick::Index(0),
         Channel::Luma => Pick::Luma,
         Channel::R => Pick::Index(0),
         Channel::G => Pick::Index(1),
         Channel::B => Pick::Index(2),
-    };
+    })
+}
+
+/// One row of raw samples to heights.
+#[inline]
+pub(crate) fn convert_row<T: Copy>(raw: &[T], ch: usize, pick: Pick, f: impl Fn(T) -> f32, out: &mut [f32]) {
+    match pick {
+        Pick::Index(i) => out.iter_mut().zip(raw.chunks_exact(ch)).for_each(|(o, p)| *o = f(p[i])),
+        Pick::Luma => out.iter_mut().zip(raw.chunks_exact(ch)).for_each(|(o, p)| {
+            *o = LUMA[0] * f(p[0]) + LUMA[1] * f(p[1]) + LUMA[2] * f(p[2]);
+        }),
+    }
+}
+
+/// One row of big-endian 16-bit samples (as PNG stores them) to heights.
+#[inline]
+pub(crate) fn convert_row_be16(raw: &[u8], ch: usize, pick: Pick, out: &mut [f32]) {
+    let s = |p: &[u8], i: usize| u16::from_be_bytes([p[2 * i], p[2 * i + 1]]) as f32 / 65535.0;
+    match pick {
+        Pick::Index(i) => out.iter_mut().zip(raw.chunks_exact(2 * ch)).for_each(|(o, p)| *o = s(p, i)),
+        Pick::Luma => out.iter_mut().zip(raw.chunks_exact(2 * ch)).for_each(|(o, p)| {
+            *o = LUMA[0] * s(p, 0) + LUMA[1] * s(p, 1) + LUMA[2] * s(p, 2);
+        }),
+    }
+}
+
+/// Turns a decoded image into heights. The error says what is wrong, without the file name.
+pub fn height_from_image(img: &DynamicImage, channel: Channel) -> Result<HeightPlane, String> {
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let has_alpha = img.color().has_alpha();
+    let channels = img.color().channel_count() as usize;
+    let pick = pick(channel, channels, has_alpha, img.color().has_color())?;
     let data = match img {
         DynamicImage::ImageLuma8(b) => convert(b.as_raw(), w, 1, pick, |v| v as f32 / 255.0),
         DynamicImage::ImageLumaA8(b) => convert(b.as_raw(), w, 2, pick, |v| v as f32 / 255.0),
@@ -99,43 +124,24 @@ pub fn height_from_image(img: &DynamicImage, channel: Channel) -> Result<HeightP
             convert(rgba.as_raw(), w, 4, pick, |v| v)
         }
     };
-    if let Some(i) = data.iter().position(|v| !v.is_finite()) {
-        return Err(format!(
-            "height sample at column {}, row {} is {}",
-            i % w,
-            i / w,
-            data[i]
-        ));
-    }
-    Ok(HeightPlane {
-        width: w,
-        height: h,
-        data,
-    })
+    check_finite(&data, w)?;
+    Ok(HeightPlane { width: w, height: h, data })
 }
 
-fn convert<T: Copy + Sync>(
-    raw: &[T],
-    w: usize,
-    ch: usize,
-    pick: Pick,
-    f: impl Fn(T) -> f32 + Sync,
-) -> Vec<f32> {
+/// Float inputs may hold NaN or infinities, which no filter can differentiate.
+pub(crate) fn check_finite(data: &[f32], w: usize) -> Result<(), String> {
+    match data.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(format!("height sample at column {}, row {} is {}", i % w, i / w, data[i])),
+        None => Ok(()),
+    }
+}
+
+fn convert<T: Copy + Sync>(raw: &[T], w: usize, ch: usize, pick: Pick, f: impl Fn(T) -> f32 + Sync) -> Vec<f32> {
     let mut out = vec![0.0f32; raw.len() / ch];
     if w == 0 {
         return out;
     }
-    out.par_chunks_mut(w)
-        .zip(raw.par_chunks(w * ch))
-        .for_each(|(o, r)| match pick {
-            Pick::Index(i) => o
-                .iter_mut()
-                .zip(r.chunks_exact(ch))
-                .for_each(|(o, p)| *o = f(p[i])),
-            Pick::Luma => o.iter_mut().zip(r.chunks_exact(ch)).for_each(|(o, p)| {
-                *o = LUMA[0] * f(p[0]) + LUMA[1] * f(p[1]) + LUMA[2] * f(p[2]);
-            }),
-        });
+    out.par_chunks_mut(w).zip(raw.par_chunks(w * ch)).for_each(|(o, r)| convert_row(r, ch, pick, &f, o));
     out
 }
 

@@ -38,14 +38,70 @@ pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
     let mut limits = Limits::no_limits();
     limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 24));
     reader.limits(limits);
-    let what = format!(
-        "cannot decode as {:?}",
-        reader.format().expect("checked above")
-    );
+    let what = match reader.format() {
+        Some(image::ImageFormat::Png) => "cannot decode as PNG".to_string(),
+        Some(image::ImageFormat::Tiff) => "cannot decode as TIFF".to_string(),
+        Some(image::ImageFormat::OpenExr) => "cannot decode as EXR".to_string(),
+        other => format!("cannot decode as {other:?}"),
+    };
     let decoder = reader
         .into_decoder()
         .map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
     let (w, h) = decoder.dimensions();
+    check_size(path, w, h, max_pixels)?;
+    DynamicImage::from_decoder(decoder)
+        .map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))
+}
+
+/// Reads a height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA, palette), TIFF, or EXR.
+pub fn load_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<HeightPlane> {
+    let is_png = ImageReader::open(path)
+        .ok()
+        .and_then(|r| r.with_guessed_format().ok())
+        .is_some_and(|r| r.format() == Some(image::ImageFormat::Png));
+    if is_png {
+        if let Some(plane) = load_png_height(path, channel, max_pixels)? {
+            return Ok(plane);
+        }
+    }
+    let img = open_image(path, max_pixels)?;
+    height_from_image(&img, channel).map_err(|m| Error::input(path, m))
+}
+
+/// PNG rows straight into the height plane, as they are inflated: no decoded image in between
+/// (a 16-bit 4096² map would be 32 MB more) and no separate conversion pass. `None` for
+/// interlaced files, which the general path handles.
+fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Option<HeightPlane>> {
+    let bad = |e: png::DecodingError| Error::input(path, format!("cannot decode as PNG: {}", one_line(e)));
+    let file = std::fs::File::open(path).map_err(|e| Error::input(path, format!("cannot open: {}", one_line(e))))?;
+    let mut decoder = png::Decoder::new(std::io::BufReader::with_capacity(1 << 16, file));
+    decoder.set_transformations(png::Transformations::EXPAND);
+    decoder.set_limits(png::Limits { bytes: usize::MAX });
+    let mut reader = decoder.read_info().map_err(bad)?;
+    let (w, h) = (reader.info().width, reader.info().height);
+    check_size(path, w, h, max_pixels)?;
+    if reader.info().interlaced {
+        return Ok(None);
+    }
+    let (color, depth) = reader.output_color_type();
+    let ch = color.samples();
+    let has_alpha = matches!(color, png::ColorType::GrayscaleAlpha | png::ColorType::Rgba);
+    let is_colour = matches!(color, png::ColorType::Rgb | png::ColorType::Rgba);
+    let pick = super::height::pick(channel, ch, has_alpha, is_colour).map_err(|m| Error::input(path, m))?;
+    let (w, h) = (w as usize, h as usize);
+    let mut data = vec![0.0f32; w * h];
+    for out in data.chunks_exact_mut(w) {
+        let row = reader.next_row().map_err(bad)?.ok_or_else(|| Error::input(path, "cannot decode as PNG: rows missing"))?;
+        let raw = row.data();
+        match depth {
+            png::BitDepth::Sixteen => super::height::convert_row_be16(raw, ch, pick, out),
+            _ => super::height::convert_row(raw, ch, pick, |v| v as f32 / 255.0, out),
+        }
+    }
+    Ok(Some(HeightPlane { width: w, height: h, data }))
+}
+
+fn check_size(path: &Path, w: u32, h: u32, max_pixels: u64) -> Result<()> {
     let pixels = w as u64 * h as u64;
     if pixels == 0 {
         return Err(Error::input(path, format!("image is {w}x{h}: no pixels")));
@@ -56,14 +112,7 @@ pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
             format!("image is {w}x{h} = {pixels} pixels, more than the limit of {max_pixels} (--max-pixels)"),
         ));
     }
-    DynamicImage::from_decoder(decoder)
-        .map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))
-}
-
-/// Reads a height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA), TIFF, or EXR.
-pub fn load_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<HeightPlane> {
-    let img = open_image(path, max_pixels)?;
-    height_from_image(&img, channel).map_err(|m| Error::input(path, m))
+    Ok(())
 }
 
 /// Reads an encoded normal map (RGB or RGBA; 8-bit, 16-bit or float) without decoding texels.
@@ -272,18 +321,76 @@ pub struct Convert {
 
 /// Runs [`Convert`]: decode, filter + encode, serialise, write. Returns the stage timings
 /// (`decode`, `filter`, `encode`, `write`, in ms). Nothing is written unless all succeeds.
+///
+/// PNG output is streamed: strips of rows are filtered (in parallel) into one reused buffer and
+/// handed to the compressor, so the encoded map never exists whole and memory stays at about
+/// the height plane plus the compressed file.
 pub fn convert_file(c: &Convert, progress: Progress) -> Result<Timings> {
     let format = OutputFormat::from_path(&c.output)?;
     let mut t = Timings::default();
     let height = t.time("decode", || load_height(&c.input, c.channel, c.max_pixels))?;
-    let img = t.time("filter", || {
-        encode_normals(&height, &c.options, &c.encode, progress)
-    });
-    drop(height);
-    let bytes = t
-        .time("encode", || image_bytes(&img, format, c.png))
-        .map_err(|m| Error::output(&c.output, m))?;
-    drop(img);
+    let bytes = if format == OutputFormat::Png && c.encode.depth != Depth::Float {
+        let (bytes, filter_ms, encode_ms) =
+            png_streamed(&height, &c.options, &c.encode, c.png, progress).map_err(|m| Error::output(&c.output, m))?;
+        t.stages.push(("filter".into(), filter_ms));
+        t.stages.push(("encode".into(), encode_ms));
+        bytes
+    } else {
+        let img = t.time("filter", || encode_normals(&height, &c.options, &c.encode, progress));
+        drop(height);
+        t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))?
+    };
     t.time("write", || crate::output::write_atomic(&c.output, &bytes))?;
     Ok(t)
+}
+
+/// Strip-by-strip filtering and PNG compression; returns the bytes and the time spent in
+/// each (ms).
+fn png_streamed(
+    height: &HeightPlane,
+    opts: &Options,
+    enc: &EncodeOptions,
+    settings: PngSettings,
+    progress: Progress,
+) -> std::result::Result<(Vec<u8>, f64, f64), String> {
+    use std::io::Write;
+    use std::time::Instant;
+    let (w, h) = (height.width, height.height);
+    let ch = if enc.alpha_height { 4 } else { 3 };
+    let sample_bytes = if enc.depth == Depth::Bits16 { 2 } else { 1 };
+    // About 2 MB a strip: large enough for every worker to get many bands, small enough to
+    // stay in cache between the filter writing it and the compressor reading it.
+    let strip = ((2 << 20) / (w * ch * sample_bytes)).clamp(8, 1024);
+    let mut out = Vec::new();
+    let (mut filter_ms, mut encode_ms) = (0.0, 0.0);
+    {
+        let mut e = png::Encoder::new(&mut out, w as u32, h as u32);
+        e.set_color(if ch == 4 { png::ColorType::Rgba } else { png::ColorType::Rgb });
+        e.set_depth(if sample_bytes == 2 { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
+        e.set_compression(settings.compression);
+        e.set_filter(settings.filter);
+        let mut writer = e.write_header().map_err(one_line)?;
+        let mut stream = writer.stream_writer_with_size(1 << 20).map_err(one_line)?;
+        let mut strips = super::encode::Strips::new(height, opts, enc);
+        let mut be: Vec<u8> = Vec::new();
+        for y0 in (0..h).step_by(strip) {
+            let n = strip.min(h - y0);
+            let t0 = Instant::now();
+            strips.encode(y0, n, progress);
+            let t1 = Instant::now();
+            if sample_bytes == 2 {
+                be.clear();
+                be.extend(strips.u16s.iter().flat_map(|v| v.to_be_bytes()));
+                stream.write_all(&be).map_err(one_line)?;
+            } else {
+                stream.write_all(&strips.u8s).map_err(one_line)?;
+            }
+            filter_ms += (t1 - t0).as_secs_f64() * 1e3;
+            encode_ms += t1.elapsed().as_secs_f64() * 1e3;
+        }
+        let t1 = Instant::now();
+        stream.finish().map_err(one_line)?;
+        encode_ms += t1.elapsed().as_secs_f64() * 1e3;
+    }
+    Ok((out, filter_ms, encode_ms))
 }

@@ -28,6 +28,7 @@ const LIM: f32 = 1e15;
 /// [`unit_normal`] over a row into three planes, `n.y` times `ysign`: a loop of independent
 /// lanes that compiles to packed SSE (min/max, sqrt, div), unlike the interleaved form.
 #[inline(always)]
+#[allow(clippy::manual_clamp)]
 pub(crate) fn unit_normals_planar(gx: &[f32], gy: &[f32], s: f32, ysign: f32, n: &mut [Vec<f32>; 3]) {
     let w = gx.len();
     let [nx, ny, nz] = n;
@@ -93,45 +94,76 @@ pub(crate) fn for_each_row<T: Send, S>(
     state: impl Fn() -> S + Sync,
     sink: impl Fn(usize, usize, &[f32], &[f32], &mut [T], &mut S) + Sync,
 ) {
-    let (w, ht) = (h.width, h.height);
-    assert_eq!(out.len(), stride * ht, "output buffer does not match the plane");
-    if w == 0 || ht == 0 {
+    if h.width == 0 || h.height == 0 {
         return;
     }
-    let per_texel = stride / w;
-    let src = Source::new(h, opts);
-    // Enough bands to balance the workers, few enough that per-band scratch is noise.
-    let band = (ht / (rayon::current_num_threads() * 8)).clamp(1, 64);
-    out.par_chunks_mut(stride * band).enumerate().for_each(|(b, chunk)| {
-        let mut scratch = src.scratch(w);
-        let mut st = state();
-        let full = matches!(src, Source::Spectral(_));
-        let tile_len = if full { w } else { TILE.min(w) };
-        let (mut gx, mut gy) = (vec![0.0f32; tile_len], vec![0.0f32; tile_len]);
-        for (i, row) in chunk.chunks_mut(stride).enumerate() {
-            let y = b * band + i;
-            match (&src, &mut scratch) {
-                (Source::R1(k), Scratch::Row(s)) => k.vertical(&h.data, w, ht, opts.wrap, y, s),
-                (Source::R2(k), Scratch::Row(s)) => k.vertical(&h.data, w, ht, opts.wrap, y, s),
-                (Source::Spectral(k), Scratch::Spectral(s)) => k.row(y, s, &mut gx, &mut gy),
-                _ => unreachable!("scratch made by its own source"),
-            }
-            for x0 in (0..w).step_by(TILE) {
-                let n = TILE.min(w - x0);
-                let out = &mut row[x0 * per_texel..(x0 + n) * per_texel];
-                match (&src, &scratch) {
-                    (Source::R1(k), Scratch::Row(s)) => k.horizontal(s, x0, &mut gx[..n], &mut gy[..n]),
-                    (Source::R2(k), Scratch::Row(s)) => k.horizontal(s, x0, &mut gx[..n], &mut gy[..n]),
-                    _ => {
-                        sink(y, x0, &gx[x0..x0 + n], &gy[x0..x0 + n], out, &mut st);
-                        continue;
-                    }
+    Rows::new(h, opts).run(0, out, stride, progress, state, sink);
+}
+
+/// A filter set up over one plane (the spectral filter's column pass done), to be run over
+/// strips of rows: the streaming PNG writer filters a strip, compresses it, and goes on.
+pub(crate) struct Rows<'a> {
+    h: &'a HeightPlane,
+    opts: Options,
+    src: Source<'a>,
+}
+
+impl<'a> Rows<'a> {
+    pub fn new(h: &'a HeightPlane, opts: &Options) -> Rows<'a> {
+        Rows { h, opts: *opts, src: Source::new(h, opts) }
+    }
+
+    /// [`for_each_row`] over rows `y0..y0 + out.len() / stride`.
+    pub fn run<T: Send, S>(
+        &self,
+        y0: usize,
+        out: &mut [T],
+        stride: usize,
+        progress: Progress,
+        state: impl Fn() -> S + Sync,
+        sink: impl Fn(usize, usize, &[f32], &[f32], &mut [T], &mut S) + Sync,
+    ) {
+        let (h, src, wrap) = (self.h, &self.src, self.opts.wrap);
+        let (w, ht) = (h.width, h.height);
+        let nrows = out.len() / stride.max(1);
+        assert!(out.len() == stride * nrows && y0 + nrows <= ht, "output buffer does not match the plane");
+        if w == 0 || nrows == 0 {
+            return;
+        }
+        let per_texel = stride / w;
+        // Enough bands to balance the workers, few enough that per-band scratch is noise.
+        let band = (nrows / (rayon::current_num_threads() * 8)).clamp(1, 64);
+        out.par_chunks_mut(stride * band).enumerate().for_each(|(b, chunk)| {
+            let mut scratch = src.scratch(w);
+            let mut st = state();
+            let full = matches!(src, Source::Spectral(_));
+            let tile_len = if full { w } else { TILE.min(w) };
+            let (mut gx, mut gy) = (vec![0.0f32; tile_len], vec![0.0f32; tile_len]);
+            for (i, row) in chunk.chunks_mut(stride).enumerate() {
+                let y = y0 + b * band + i;
+                match (src, &mut scratch) {
+                    (Source::R1(k), Scratch::Row(s)) => k.vertical(&h.data, w, ht, wrap, y, s),
+                    (Source::R2(k), Scratch::Row(s)) => k.vertical(&h.data, w, ht, wrap, y, s),
+                    (Source::Spectral(k), Scratch::Spectral(s)) => k.row(y, s, &mut gx, &mut gy),
+                    _ => unreachable!("scratch made by its own source"),
                 }
-                sink(y, x0, &gx[..n], &gy[..n], out, &mut st);
+                for x0 in (0..w).step_by(TILE) {
+                    let n = TILE.min(w - x0);
+                    let out = &mut row[x0 * per_texel..(x0 + n) * per_texel];
+                    match (src, &scratch) {
+                        (Source::R1(k), Scratch::Row(s)) => k.horizontal(s, x0, &mut gx[..n], &mut gy[..n]),
+                        (Source::R2(k), Scratch::Row(s)) => k.horizontal(s, x0, &mut gx[..n], &mut gy[..n]),
+                        _ => {
+                            sink(y, x0, &gx[x0..x0 + n], &gy[x0..x0 + n], out, &mut st);
+                            continue;
+                        }
+                    }
+                    sink(y, x0, &gx[..n], &gy[..n], out, &mut st);
+                }
             }
-        }
-        if let Some(p) = progress {
-            p(chunk.len() / stride);
-        }
-    });
+            if let Some(p) = progress {
+                p(chunk.len() / stride);
+            }
+        });
+    }
 }

@@ -6,10 +6,14 @@
 //! x-frequency only), so the filter is separable: rows for `dh/dx`, columns for `dh/dy_up`, and
 //! it needs one extra float plane (the column derivatives), never a complex 2-D spectrum.
 //!
-//! `repeat` uses the image's own period. `clamp` and `mirror` first mirror-extend each line to
-//! twice its length (`h0..h(n-1), h(n-1)..h0`), which is periodic and continuous, so there is no
-//! jump at the seam to ring; the slope still changes sign at the edge, so the error there is
-//! like any one-sided estimate, and falls off within a few texels.
+//! `repeat` uses the image's own period. `clamp` and `mirror` (treated alike) first remove the
+//! line through each line's end samples, then mirror-extend the rest to twice its length
+//! (`r0..r(n-1), r(n-1)..r0`), which is periodic and continuous, so there is no jump at the
+//! seam to ring, and a ramp is differentiated exactly. What remains at the edges is the corner
+//! where the residual's slope changes sign; its ringing falls off within a few texels.
+
+// Lines are indexed from both ends (mirror extension, bottom-up columns): index loops read best.
+#![allow(clippy::needless_range_loop)]
 
 use super::Wrap;
 use rayon::prelude::*;
@@ -69,29 +73,41 @@ impl Line {
     }
 
     /// Writes the line `a` (real part) and `b` (imaginary part) into `buf`, extended as planned,
-    /// less its mean. The mean has no slope; removing it makes a constant line exactly zero
-    /// (so a flat map encodes to exactly 128,128,255 instead of carrying the transform's
-    /// rounding noise) and keeps the other bins' rounding relative to the relief, not the level.
+    /// less a trend whose slope it returns (to be added back to the derivative).
+    ///
+    /// `repeat` removes the mean: it has no slope, and without it a constant line would come
+    /// back as the transform's rounding noise instead of exactly zero (a flat map must encode to
+    /// exactly 128,128,255). The mirrored modes remove the line through the two end samples,
+    /// so the extension has no corner for a ramp (exact on ramps, and far less ringing at the
+    /// edges of sloped maps), and a constant line is exactly zero here too.
     #[inline]
-    fn fill(&self, buf: &mut [Complex32], a: impl Fn(usize) -> f32, b: impl Fn(usize) -> f32) {
+    fn fill(&self, buf: &mut [Complex32], a: impl Fn(usize) -> f32, b: impl Fn(usize) -> f32) -> Complex32 {
+        let n = self.n;
         let mut sum = [0.0f64; 2];
-        for i in 0..self.n {
+        for i in 0..n {
             let v = Complex32::new(a(i), b(i));
             sum[0] += v.re as f64;
             sum[1] += v.im as f64;
             buf[i] = v;
         }
-        let mean = Complex32::new(
-            (sum[0] / self.n as f64) as f32,
-            (sum[1] / self.n as f64) as f32,
-        );
-        for i in 0..self.n {
-            let v = buf[i] - mean;
+        let (first, last) = (buf[0], buf[n - 1]);
+        let trend = |i: usize| -> (Complex32, Complex32) {
+            if self.len == self.n {
+                let mean = Complex32::new((sum[0] / n as f64) as f32, (sum[1] / n as f64) as f32);
+                (mean, Complex32::default())
+            } else {
+                let slope = (last - first) / (n - 1).max(1) as f32;
+                (first + slope * i as f32, slope)
+            }
+        };
+        for i in 0..n {
+            let v = buf[i] - trend(i).0;
             buf[i] = v;
-            if self.len > self.n {
+            if self.len > n {
                 buf[self.len - 1 - i] = v;
             }
         }
+        trend(0).1
     }
 
     /// Differentiates in place. The operator is real, so the derivatives of two real lines
@@ -147,7 +163,7 @@ impl<'a> Spectral<'a> {
                     let (xa, xb) = (x0 + pair, x0 + pair + 1);
                     let has_b = pair + 1 < ncols;
                     // Row index y is y_up = height-1-y, so feed the column bottom-up.
-                    cols.fill(
+                    let slope = cols.fill(
                         &mut buf,
                         |i| plane[(height - 1 - i) * width + xa],
                         |i| {
@@ -161,9 +177,9 @@ impl<'a> Spectral<'a> {
                     cols.differentiate(&mut buf, &mut scratch);
                     for i in 0..height {
                         let y = height - 1 - i;
-                        out[y * BLOCK + pair] = buf[i].re;
+                        out[y * BLOCK + pair] = buf[i].re + slope.re;
                         if has_b {
-                            out[y * BLOCK + pair + 1] = buf[i].im;
+                            out[y * BLOCK + pair + 1] = buf[i].im + slope.im;
                         }
                     }
                 }
@@ -185,10 +201,10 @@ impl<'a> Spectral<'a> {
     pub fn row(&self, y: usize, s: &mut SpectralScratch, gx: &mut [f32], gy: &mut [f32]) {
         let w = self.width;
         let row = &self.plane[y * w..(y + 1) * w];
-        self.rows.fill(&mut s.buf, |i| row[i], |_| 0.0);
+        let slope = self.rows.fill(&mut s.buf, |i| row[i], |_| 0.0);
         self.rows.differentiate(&mut s.buf, &mut s.scratch);
         for x in 0..w {
-            gx[x] = s.buf[x].re;
+            gx[x] = s.buf[x].re + slope.re;
         }
         for (b, chunk) in gy[..w].chunks_mut(BLOCK).enumerate() {
             let src = &self.gy_blocks[(b * self.height + y) * BLOCK..][..chunk.len()];
@@ -249,16 +265,25 @@ mod tests {
     }
 
     #[test]
-    fn mirror_extension_is_exact_on_a_ramp_interior() {
-        let (w, h) = (64, 3);
-        let plane: Vec<f32> = (0..w * h).map(|i| 0.01 * (i % w) as f32).collect();
-        let s = Spectral::new(&plane, w, h, Wrap::Mirror);
-        let (gx, gy) = all_grads(&s, w, h);
-        // The even extension of a ramp is a triangle wave: its corner rings, but the middle
-        // third of the line is close to the true slope.
-        for x in w / 3..2 * w / 3 {
-            assert!((gx[w + x] - 0.01).abs() < 1e-3, "gx {} at {x}", gx[w + x]);
+    fn mirrored_modes_are_exact_on_a_ramp() {
+        let (w, h) = (37, 5);
+        let plane: Vec<f32> = (0..w * h).map(|i| 0.01 * (i % w) as f32 - 0.03 * (i / w) as f32).collect();
+        for wrap in [Wrap::Mirror, Wrap::Clamp] {
+            let s = Spectral::new(&plane, w, h, wrap);
+            let (gx, gy) = all_grads(&s, w, h);
+            for i in 0..w * h {
+                assert!((gx[i] - 0.01).abs() < 1e-5, "gx {} at {i}", gx[i]);
+                assert!((gy[i] - 0.03).abs() < 1e-5, "gy {} at {i}", gy[i]);
+            }
         }
-        assert!(gy.iter().all(|g| g.abs() < 1e-6));
+    }
+
+    #[test]
+    fn constant_lines_are_exactly_flat() {
+        let plane = vec![0.7f32; 12 * 9];
+        for wrap in [Wrap::Repeat, Wrap::Mirror] {
+            let (gx, gy) = all_grads(&Spectral::new(&plane, 12, 9, wrap), 12, 9);
+            assert!(gx.iter().chain(&gy).all(|g| *g == 0.0));
+        }
     }
 }
