@@ -50,3 +50,34 @@ fn depfile_lists_every_input_read() {
         assert!(deps.contains(s(&fixture(f))), "{f} in {text}");
     }
 }
+
+#[test]
+fn normalmap_batch_writes_the_good_maps_and_names_the_bad_one() {
+    let d = scratch_dir("nm_batch_in");
+    let out = scratch_dir("nm_batch_out");
+    std::fs::copy(fixture("bake/bumps.png"), d.join("a.png")).unwrap();
+    std::fs::write(d.join("b.png"), b"\x89PNG\r\n\x1a\nbroken").unwrap();
+    image::GrayImage::from_pixel(3, 3, image::Luma([7])).save(d.join("c.png")).unwrap();
+    let o = run(&["normalmap", s(&d.join("a.png")), s(&d.join("b.png")), s(&d.join("c.png")), "--out-dir", s(&out), "--json", "-j", "2"]);
+    assert_eq!(o.status.code(), Some(2));
+    let recs: Vec<serde_json::Value> = String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(recs.iter().map(|r| r["status"].as_str().unwrap()).collect::<Vec<_>>(), ["ok", "error", "ok"]);
+    assert!(recs[0]["timings_ms"]["stages"].as_array().unwrap().len() >= 2);
+    assert!(recs[1]["error"].as_str().unwrap().contains("b.png"));
+    let flat = image::open(out.join("c.png")).unwrap().to_rgb8();
+    assert!(flat.pixels().all(|p| p.0 == [128, 128, 255]), "constant height is flat");
+    assert!(out.join("a.png").exists() && !out.join("b.png").exists());
+}
+
+#[test]
+fn bake_batch_with_out_dir() {
+    let d = scratch_dir("bake_batch_in");
+    let v = validated_dir("bake_batch");
+    for name in ["torus.obj", "torus.mtl", "bumps.png"] {
+        std::fs::copy(fixture(&format!("bake/{name}")), d.join(name)).unwrap();
+    }
+    std::fs::copy(d.join("torus.obj"), d.join("torus2.obj")).unwrap();
+    let o = run(&["bake", s(&d.join("torus.obj")), s(&d.join("torus2.obj")), "--out-dir", s(&v), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(v.join("torus.glb")).unwrap(), std::fs::read(v.join("torus2.glb")).unwrap());
+}

@@ -7,7 +7,8 @@ use bumpbake::normalmap::{
 use bumpbake::{Error, Result};
 use clap::builder::TypedValueParser;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use bumpbake::batch::{self, BatchOptions};
+use std::path::{Path, PathBuf};
 
 /// What alpha holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -22,11 +23,30 @@ pub enum Alpha {
   bumpbake normalmap terrain16.png -o terrain_n.png --bits 16 --height-range 0.05 --texel-size 0.001 --wrap repeat
   bumpbake normalmap depth.exr -o n.png --invert --convention directx --alpha height --filter spectral")]
 pub struct Args {
-    /// Height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA), TIFF or EXR.
-    pub height: PathBuf,
-    /// Normal map to write: .png (8 or 16-bit), .tif, or .exr (32-bit float).
-    #[arg(short, long, value_name = "NORMAL")]
-    pub output: PathBuf,
+    /// Height maps: PNG (8/16-bit gray, gray+alpha, RGB, RGBA), TIFF or EXR.
+    #[arg(required = true)]
+    pub heights: Vec<PathBuf>,
+    /// Normal map to write (one input): .png (8 or 16-bit), .tif, or .exr (32-bit float).
+    #[arg(short, long, value_name = "NORMAL", conflicts_with = "out_dir")]
+    pub output: Option<PathBuf>,
+    /// Output folder (any number of inputs); names follow the inputs.
+    #[arg(long)]
+    pub out_dir: Option<PathBuf>,
+    /// Extension of the outputs written into --out-dir.
+    #[arg(long, value_parser = ["png", "tif", "exr"], default_value = "png")]
+    pub out_ext: String,
+    /// Files processed at once (default: one per core).
+    #[arg(short, long, default_value_t = 0)]
+    pub jobs: usize,
+    /// One JSON record per file on stdout (JSON Lines).
+    #[arg(long)]
+    pub json: bool,
+    /// No messages on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Show a progress bar even when not on a terminal.
+    #[arg(long)]
+    pub progress: bool,
     /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
     #[arg(long, value_enum, default_value_t = Channel::Luma)]
     pub channel: Channel,
@@ -98,33 +118,61 @@ fn strength(args: &Args) -> Result<f32> {
     Ok(s)
 }
 
+/// What one conversion did, for `--json`.
+#[derive(serde::Serialize)]
+struct Record {
+    input: PathBuf,
+    output: PathBuf,
+    timings_ms: bumpbake::report::Timings,
+}
+
 pub fn run(args: Args) -> Result<u8> {
-    let format = nm::OutputFormat::from_path(&args.output)?;
-    let depth = format.depth(&args.output, args.bits)?;
+    let outputs = super::report::outputs(&args.heights, &args.output, &args.out_dir, &args.out_ext)?;
     let options = Options {
         strength: strength(&args)?,
         filter: args.filter,
         wrap: args.wrap,
         invert: args.invert,
     };
-    let convert = Convert {
-        input: args.height.clone(),
-        output: args.output.clone(),
-        channel: args.channel,
-        max_pixels: args.max_pixels,
-        options,
-        encode: EncodeOptions {
-            depth,
-            convention: args.convention,
-            alpha_height: args.alpha == Some(Alpha::Height),
-        },
-        png: nm::PngSettings::default(),
+    let convert = |input: &Path, output: &Path| -> Result<Convert> {
+        let format = nm::OutputFormat::from_path(output)?;
+        Ok(Convert {
+            input: input.to_path_buf(),
+            output: output.to_path_buf(),
+            channel: args.channel,
+            max_pixels: args.max_pixels,
+            options,
+            encode: EncodeOptions {
+                depth: format.depth(output, args.bits)?,
+                convention: args.convention,
+                alpha_height: args.alpha == Some(Alpha::Height),
+            },
+            png: nm::PngSettings::default(),
+        })
     };
-    let bar = progress_bar(&args);
-    let tick = |rows: usize| bar.inc(rows as u64);
-    let result = nm::convert_file(&convert, Some(&tick));
-    bar.finish_and_clear();
-    result.map(|_| 0)
+    let results = if args.heights.len() == 1 {
+        // One map: a bar over its rows, for big maps on a terminal.
+        let bar = progress_bar(&args);
+        let tick = |rows: usize| bar.inc(rows as u64);
+        let r = convert(&args.heights[0], &outputs[0]).and_then(|c| nm::convert_file(&c, Some(&tick)));
+        bar.finish_and_clear();
+        vec![r]
+    } else {
+        let opts = BatchOptions { jobs: args.jobs, force_progress: args.progress, quiet: args.quiet || args.json };
+        batch::run(&args.heights, &opts, |input| convert(input, super::report::paired(&args.heights, &outputs, input)).and_then(|c| nm::convert_file(&c, None)))?
+    };
+    let records: Vec<Result<Record>> = results
+        .into_iter()
+        .zip(args.heights.iter().zip(&outputs))
+        .map(|(r, (i, o))| r.map(|t| Record { input: i.clone(), output: o.clone(), timings_ms: t }))
+        .collect();
+    super::report::print(&args.heights, records, args.json, args.quiet, |r| {
+        if args.heights.len() > 1 {
+            format!("{} -> {}\n", r.input.display(), r.output.display())
+        } else {
+            String::new()
+        }
+    })
 }
 
 /// A bar on a terminal for maps big enough to wait for; nothing when piped or under CI.
@@ -132,12 +180,12 @@ fn progress_bar(args: &Args) -> indicatif::ProgressBar {
     let ci = std::env::var("CI")
         .map(|v| v == "true" || v == "1")
         .unwrap_or(false);
-    if ci || !std::io::stderr().is_terminal() {
+    if args.quiet || (!args.progress && (ci || !std::io::stderr().is_terminal())) {
         return indicatif::ProgressBar::hidden();
     }
     // The header is read again by the conversion; this costs microseconds and keeps the
     // library free of terminal concerns.
-    let rows = image::ImageReader::open(&args.height)
+    let rows = image::ImageReader::open(&args.heights[0])
         .ok()
         .and_then(|r| r.with_guessed_format().ok())
         .and_then(|r| r.into_dimensions().ok())
@@ -154,7 +202,7 @@ fn progress_bar(args: &Args) -> indicatif::ProgressBar {
                 .unwrap()
                 .progress_chars("=> "),
             );
-            bar.set_message(format!("normalmap {}", args.height.display()));
+            bar.set_message(format!("normalmap {}", args.heights[0].display()));
             bar
         }
         None => indicatif::ProgressBar::hidden(),
