@@ -81,3 +81,15 @@ fn bake_batch_with_out_dir() {
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(std::fs::read(v.join("torus.glb")).unwrap(), std::fs::read(v.join("torus2.glb")).unwrap());
 }
+
+#[test]
+fn validate_batch_goes_on_past_an_unusable_file() {
+    let d = scratch_dir("validate_batch");
+    std::fs::write(d.join("bad.glb"), b"glTF").unwrap();
+    let good = fixture("khronos/NormalTangentMirrorTest.glb");
+    let o = run(&["validate", s(&good), s(&d.join("bad.glb")), s(&good), "--format", "json", "-j", "2"]);
+    assert_eq!(o.status.code(), Some(2), "an unusable file makes the run exit 2");
+    let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(rep["files"].as_array().unwrap().len(), 2, "both good files are reported: {rep}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("bad.glb"));
+}

@@ -42,6 +42,9 @@ pub struct Args {
     /// No human summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Files checked at once (default: one per core).
+    #[arg(short, long, default_value_t = 0)]
+    pub jobs: usize,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,7 +80,11 @@ pub fn run(a: Args) -> Result<u8> {
     if let Some(c) = opts.deny.iter().find(|c| opts.allow.contains(c)) {
         return Err(Error::usage(format!("{c} is given to both --deny and --allow")));
     }
-    let rep = validate::validate_paths(&a.inputs, &opts)?;
+    let (rep, failed) = if a.inputs.len() == 1 {
+        (validate::validate_paths(&a.inputs, &opts)?, Vec::new())
+    } else {
+        validate::validate_many(&a.inputs, &opts, a.jobs)?
+    };
     match a.format {
         Format::Text => {}
         Format::Json => println!("{}", report::json(&rep)),
@@ -87,5 +94,9 @@ pub fn run(a: Args) -> Result<u8> {
     if !a.quiet {
         eprint!("{}", report::text(&rep));
     }
-    Ok(rep.exit_code())
+    // Unusable files come last, each on its own line; they make the run exit 2.
+    for e in &failed {
+        eprintln!("bumpbake: {e}");
+    }
+    Ok(if failed.is_empty() { rep.exit_code() } else { 2 })
 }

@@ -252,6 +252,22 @@ pub fn validate_paths(paths: &[PathBuf], opts: &Options) -> Result<Report> {
     Ok(Report { files, strict: opts.strict, max_angle_deg: opts.max_angle_deg })
 }
 
+/// Validates many inputs, `jobs` at a time (0: one per core); an unusable file never stops the
+/// others: it is returned with its error, and the report holds every file that could be read.
+pub fn validate_many(paths: &[PathBuf], opts: &Options, jobs: usize) -> Result<(Report, Vec<Error>)> {
+    let batch = crate::batch::BatchOptions { jobs, ..Default::default() };
+    let results = crate::batch::run(paths, &batch, |p| validate_path(p, opts))?;
+    let mut files = Vec::with_capacity(paths.len());
+    let mut failed = Vec::new();
+    for r in results {
+        match r {
+            Ok(f) => files.push(f),
+            Err(e) => failed.push(e),
+        }
+    }
+    Ok((Report { files, strict: opts.strict, max_angle_deg: opts.max_angle_deg }, failed))
+}
+
 /// Validates one `.gltf`, `.glb`, `.obj`, or a normal-map image.
 pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
