@@ -1,6 +1,7 @@
 //! Benchmarks that measure error against run time (`bumpbake bench ...`): library code so that
 //! tests and the binary share it.
 
+pub mod batch;
 pub mod normalmap;
 pub mod plot;
 pub mod surfaces;

@@ -1,6 +1,6 @@
 //! `bumpbake bench ...`: error against run time for each stage.
 
-use super::{bench_normalmap, bench_tangents};
+use super::{bench_batch, bench_normalmap, bench_tangents};
 use bumpbake::Result;
 use clap::Subcommand;
 
@@ -19,11 +19,14 @@ pub enum What {
     Normalmap(bench_normalmap::BenchNormalmapArgs),
     /// Every tangent algorithm on parametric surfaces and real meshes.
     Tangents(bench_tangents::BenchTangentsArgs),
+    /// Many small assets through `bake -j N` against one process each.
+    Batch(bench_batch::BenchBatchArgs),
 }
 
 pub fn run(args: Args) -> Result<u8> {
     match args.what {
         What::Normalmap(a) => bench_normalmap::run(a),
         What::Tangents(a) => bench_tangents::run(a),
+        What::Batch(a) => bench_batch::run(a),
     }
 }

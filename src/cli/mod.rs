@@ -2,6 +2,7 @@
 
 mod bake;
 mod bench;
+mod bench_batch;
 mod bench_normalmap;
 mod bench_tangents;
 mod completions;
