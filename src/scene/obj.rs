@@ -281,24 +281,51 @@ fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<(
 }
 
 /// A bump texture is a normal map when its pixels are coloured and lean towards +Z (blue);
-/// grey pixels are heights. Unreadable images count as heights and fail later, when used.
-fn looks_like_normal_map(scene: &Scene, file: &str) -> bool {
-    let Ok(bytes) = super::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) else { return false };
-    let Ok(img) = image::load_from_memory(&bytes) else { return false };
+/// grey pixels are heights. Images that cannot be read or decoded (missing, corrupt, or claiming
+/// more pixels than [`super::image_limits`] allows, checked from the header before anything is
+/// allocated) count as heights, with a note saying why; `bake` reports them when it needs them.
+fn looks_like_normal_map(scene: &mut Scene, file: &str) -> bool {
+    let bytes = match super::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) {
+        Ok(b) => b,
+        Err(e) => {
+            scene.notes.push(format!("bump map '{file}' could not be read to classify it ({e}); taken as a height map"));
+            return false;
+        }
+    };
+    let img = match super::image_limits::decode(&bytes) {
+        Ok(i) => i,
+        Err(e) => {
+            scene.notes.push(format!("bump map '{file}': {e}; taken as a height map"));
+            return false;
+        }
+    };
+    classify_normal_map(&img)
+}
+
+/// The colour test of [`looks_like_normal_map`], on at most about a million sampled pixels.
+pub(crate) fn classify_normal_map(img: &image::DynamicImage) -> bool {
+    use image::GenericImageView as _;
     if !img.color().has_color() {
         return false;
     }
-    let rgb = img.to_rgb8();
-    let n = (rgb.width() as u64 * rgb.height() as u64).max(1) as f64;
-    let (mut sr, mut sg, mut sb, mut grey) = (0.0, 0.0, 0.0, 0u64);
-    for p in rgb.pixels() {
-        sr += p[0] as f64;
-        sg += p[1] as f64;
-        sb += p[2] as f64;
-        if p[0] == p[1] && p[1] == p[2] {
-            grey += 1;
+    let (w, h) = img.dimensions();
+    let step = ((w as u64 * h as u64) as f64 / 1_048_576.0).sqrt().ceil().max(1.0) as u32;
+    let (mut sr, mut sg, mut sb, mut grey, mut n) = (0.0, 0.0, 0.0, 0u64, 0u64);
+    for y in (0..h).step_by(step as usize) {
+        for x in (0..w).step_by(step as usize) {
+            let p = img.get_pixel(x, y);
+            // 8-bit view of any sample type.
+            let (r, g, b) = (p[0], p[1], p[2]);
+            sr += r as f64;
+            sg += g as f64;
+            sb += b as f64;
+            n += 1;
+            if r == g && g == b {
+                grey += 1;
+            }
         }
     }
+    let n = n.max(1) as f64;
     let (r, g, b) = (sr / n / 255.0, sg / n / 255.0, sb / n / 255.0);
     (grey as f64) < 0.9 * n && b > 0.6 && (r - 0.5).abs() < 0.2 && (g - 0.5).abs() < 0.2
 }
