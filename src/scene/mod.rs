@@ -224,9 +224,14 @@ impl Scene {
             }
         }
         let count = attributes.first().map(|(_, s)| s.len()).unwrap_or(0);
-        if let Some((_, pos)) = attributes.iter().find(|(n, _)| n == "POSITION") {
-            if let Some(bad) = pos.to_f32::<3>().iter().position(|v| !v.iter().all(|x| x.is_finite())) {
-                return Err(self.err(format!("{where_}: POSITION {bad} is not finite (NaN or infinity)")));
+        // Attributes the tangent math reads must be finite: a NaN there would end up in the output.
+        for (name, s) in &attributes {
+            let used = name == "POSITION" || name == "NORMAL" || name.starts_with("TEXCOORD_");
+            if used && s.format.component_type == FLOAT {
+                let n = s.format.components();
+                if let Some(bad) = (0..s.len()).find(|&i| (0..n).any(|c| !s.get(i, c).is_finite())) {
+                    return Err(self.err(format!("{where_}: {name} {bad} is not finite (NaN or infinity)")));
+                }
             }
         }
         for (name, s) in attributes.iter().chain(targets.iter().flatten()) {
