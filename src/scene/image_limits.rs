@@ -37,7 +37,10 @@ fn reader(bytes: &[u8]) -> Result<ImageReader<Cursor<&[u8]>>, String> {
 /// The size an image's header claims, checked against the limits; nothing is decoded.
 pub fn dimensions(bytes: &[u8]) -> Result<(u32, u32), String> {
     let mut r = reader(bytes)?;
-    r.limits(limits());
+    // Only the header is read here; the size checks below give the clearer message.
+    let mut header_only = Limits::default();
+    header_only.max_alloc = Some(MAX_ALLOC);
+    r.limits(header_only);
     let (w, h) = r.into_dimensions().map_err(|e| format!("unreadable image header: {e}"))?;
     check_size(w, h)?;
     Ok((w, h))
