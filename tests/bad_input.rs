@@ -362,3 +362,24 @@ fn failures_during_the_write_leave_nothing() {
     }
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
 }
+
+/// Fuzzing found this (gltf_read, `crash-ff0f4ba0…`): a primitive whose attributes have no
+/// POSITION (here misspelt `POSITIOn`) made the tangent stage index an empty position list and
+/// panic. glTF allows such primitives (clients skip them): they are skipped with a reason.
+#[test]
+fn primitive_without_position_is_skipped() {
+    let d = case("no_position");
+    let mut g = Gltf::new();
+    simple(&mut g);
+    let attrs = g.json["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap();
+    let p = attrs.remove("POSITION").unwrap();
+    attrs.insert("POSITIOn".into(), p);
+    let f = d.join("nopos.glb");
+    g.write_glb(&f);
+    let out = d.join("out.glb");
+    let o = run(&["tangents", s(&f), "-o", s(&out), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["skipped"], 1, "{report}");
+    assert!(report["primitives"][0]["reason"].as_str().unwrap().contains("POSITION"));
+}

@@ -54,7 +54,9 @@ pub fn primitive_with_tangents(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: 
 /// [`primitive_with_tangents`], with what it did.
 pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
     let uv_name = format!("TEXCOORD_{uv_set}");
-    let positions = p.positions();
+    let mut positions = p.positions();
+    // Without POSITION (callers skip such primitives) the surface is a point.
+    positions.resize(p.vertex_count(), [0.0; 3]);
     let uvs: Vec<[f32; 2]> = p.attr(&uv_name).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
     let (mut corners, targets) = unweld(p);
     corners.retain(|(n, _)| n != "TANGENT" && n != "_BITANGENT");
