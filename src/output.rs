@@ -26,6 +26,13 @@ impl Outputs {
     /// Writes every queued file to a temporary sibling, then renames them all into place.
     /// If any write fails, every temporary is removed and nothing is renamed.
     pub fn commit(self) -> Result<()> {
+        // Renames are the one step that cannot be undone once a later one fails, so everything
+        // that would make one fail is checked before the first temporary is written.
+        for (path, _) in &self.files {
+            if path.is_dir() {
+                return Err(Error::output(path, "a directory is in the way"));
+            }
+        }
         let mut temps: Vec<(PathBuf, PathBuf)> = Vec::new();
         for (path, bytes) in &self.files {
             match write_temp(path, bytes) {

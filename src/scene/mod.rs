@@ -9,6 +9,7 @@
 pub mod accessor;
 mod gltf_read;
 mod gltf_write;
+pub mod image_limits;
 mod obj;
 pub mod uri;
 pub mod weld;
@@ -120,13 +121,20 @@ impl Scene {
     /// Reads an `.obj`, `.gltf` or `.glb` file (GLB is recognised by its magic, not its name).
     pub fn read(path: &Path, opts: &ReadOptions) -> Result<Scene> {
         let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
+        Scene::read_bytes(path, &bytes, opts)
+    }
+
+    /// Reads a scene from bytes already in memory. `path` names the file in messages, decides the
+    /// format by its extension (GLB is recognised by its magic) and is the folder relative URIs
+    /// resolve against.
+    pub fn read_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
         if ext == "obj" {
-            obj::read(path, &bytes, opts)
+            obj::read(path, bytes, opts)
         } else if bytes.starts_with(b"glTF") || ext == "glb" {
-            gltf_read::read_glb(path, &bytes, opts)
+            gltf_read::read_glb(path, bytes, opts)
         } else if ext == "gltf" || bytes.first().map(|b| *b == b'{').unwrap_or(false) {
-            gltf_read::read_gltf(path, &bytes, opts)
+            gltf_read::read_gltf(path, bytes, opts)
         } else {
             Err(Error::input(path, "unknown mesh format (expected .obj, .gltf or .glb)"))
         }
@@ -255,9 +263,14 @@ impl Scene {
             }
         }
         let count = attributes.first().map(|(_, s)| s.len()).unwrap_or(0);
-        if let Some((_, pos)) = attributes.iter().find(|(n, _)| n == "POSITION") {
-            if let Some(bad) = pos.to_f32::<3>().iter().position(|v| !v.iter().all(|x| x.is_finite())) {
-                return Err(self.err(format!("{where_}: POSITION {bad} is not finite (NaN or infinity)")));
+        // Attributes the tangent math reads must be finite: a NaN there would end up in the output.
+        for (name, s) in &attributes {
+            let used = name == "POSITION" || name == "NORMAL" || name.starts_with("TEXCOORD_");
+            if used && s.format.component_type == FLOAT {
+                let n = s.format.components();
+                if let Some(bad) = (0..s.len()).find(|&i| (0..n).any(|c| !s.get(i, c).is_finite())) {
+                    return Err(self.err(format!("{where_}: {name} {bad} is not finite (NaN or infinity)")));
+                }
             }
         }
         for (name, s) in attributes.iter().chain(targets.iter().flatten()) {

@@ -129,6 +129,29 @@ fn build_primitive(path: &Path, m: &tobj::Mesh, normals: NormalMode, notes: &mut
     Ok(weld(attrs, vec![], 4))
 }
 
+/// `v` multiplied by the power of two that brings its largest component into [1, 2). Exact in
+/// floating point, so directions computed from scaled edges are bit-identical to unscaled ones for
+/// ordinary meshes, while edges of 1e-20 (whose cross product would underflow to zero) or 1e30
+/// (which would overflow) still give their true direction.
+fn pow2_scaled(v: glam::Vec3) -> glam::Vec3 {
+    let m = v.abs().max_element();
+    if m == 0.0 || !m.is_finite() {
+        return v;
+    }
+    let e = m.log2().floor() as i32;
+    // Two steps: 2^149 alone does not fit in an f32.
+    let half = 2f32.powi(-(e / 2));
+    v * half * 2f32.powi(-(e - e / 2))
+}
+
+/// The unit normal of triangle `(a, b, c)` in counter-clockwise order, whatever its size, or
+/// `None` when it has no area (in float32).
+pub(crate) fn face_normal(a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> Option<glam::Vec3> {
+    let n = pow2_scaled(pow2_scaled(b - a).cross(pow2_scaled(c - a)));
+    let n = n.normalize_or_zero();
+    (n != glam::Vec3::ZERO && n.is_finite()).then_some(n)
+}
+
 /// Angle-weighted vertex normals over shared position indices. Returns per-corner normals and
 /// how many corners had none (only degenerate faces around them).
 pub fn smooth_normals(positions: &[f32], indices: &[u32]) -> (Vec<[f32; 3]>, usize) {
@@ -136,15 +159,17 @@ pub fn smooth_normals(positions: &[f32], indices: &[u32]) -> (Vec<[f32; 3]>, usi
     let mut acc = vec![glam::Vec3::ZERO; positions.len() / 3];
     for t in indices.chunks_exact(3) {
         let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-        let n = (b - a).cross(c - a).normalize_or_zero();
+        let Some(n) = face_normal(a, b, c) else { continue };
         for (k, (o, u, v)) in [(a, b, c), (b, c, a), (c, a, b)].into_iter().enumerate() {
-            let angle = (u - o).normalize_or_zero().dot((v - o).normalize_or_zero()).clamp(-1.0, 1.0).acos();
+            let e1 = pow2_scaled(u - o).normalize_or_zero();
+            let e2 = pow2_scaled(v - o).normalize_or_zero();
+            let angle = e1.dot(e2).clamp(-1.0, 1.0).acos();
             acc[t[k] as usize] += n * angle;
         }
     }
     let mut fixed = 0;
     let out = indices.iter().map(|&i| {
-        let n = acc[i as usize].normalize_or_zero();
+        let n = pow2_scaled(acc[i as usize]).normalize_or_zero();
         if n == glam::Vec3::ZERO || !n.is_finite() {
             fixed += 1;
             [0.0, 0.0, 1.0]
@@ -155,18 +180,17 @@ pub fn smooth_normals(positions: &[f32], indices: &[u32]) -> (Vec<[f32; 3]>, usi
     (out, fixed)
 }
 
-/// One normal per face, from per-corner positions.
+/// One normal per face, from per-corner positions; faces without area get +Z.
 pub fn flat_normals(pos: &[[f32; 3]]) -> (Vec<[f32; 3]>, usize) {
     let mut fixed = 0;
     let mut out = Vec::with_capacity(pos.len());
     for t in pos.chunks_exact(3) {
-        let (a, b, c) = (glam::Vec3::from(t[0]), glam::Vec3::from(t[1]), glam::Vec3::from(t[2]));
-        let n = (b - a).cross(c - a).normalize_or_zero();
-        let n = if n == glam::Vec3::ZERO || !n.is_finite() {
-            fixed += 3;
-            [0.0, 0.0, 1.0]
-        } else {
-            n.to_array()
+        let n = match face_normal(glam::Vec3::from(t[0]), glam::Vec3::from(t[1]), glam::Vec3::from(t[2])) {
+            Some(n) => n.to_array(),
+            None => {
+                fixed += 3;
+                [0.0, 0.0, 1.0]
+            }
         };
         out.extend([n, n, n]);
     }
@@ -174,7 +198,7 @@ pub fn flat_normals(pos: &[[f32; 3]]) -> (Vec<[f32; 3]>, usize) {
 }
 
 fn unit_or_up(n: [f32; 3]) -> [f32; 3] {
-    let v = glam::Vec3::from(n).normalize_or_zero();
+    let v = pow2_scaled(glam::Vec3::from(n)).normalize_or_zero();
     if v == glam::Vec3::ZERO || !v.is_finite() {
         [0.0, 0.0, 1.0]
     } else {
@@ -281,24 +305,51 @@ fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<(
 }
 
 /// A bump texture is a normal map when its pixels are coloured and lean towards +Z (blue);
-/// grey pixels are heights. Unreadable images count as heights and fail later, when used.
-fn looks_like_normal_map(scene: &Scene, file: &str) -> bool {
-    let Ok(bytes) = super::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) else { return false };
-    let Ok(img) = image::load_from_memory(&bytes) else { return false };
+/// grey pixels are heights. Images that cannot be read or decoded (missing, corrupt, or claiming
+/// more pixels than [`super::image_limits`] allows, checked from the header before anything is
+/// allocated) count as heights, with a note saying why; `bake` reports them when it needs them.
+fn looks_like_normal_map(scene: &mut Scene, file: &str) -> bool {
+    let bytes = match super::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) {
+        Ok(b) => b,
+        Err(e) => {
+            scene.notes.push(format!("bump map '{file}' could not be read to classify it ({e}); taken as a height map"));
+            return false;
+        }
+    };
+    let img = match super::image_limits::decode(&bytes) {
+        Ok(i) => i,
+        Err(e) => {
+            scene.notes.push(format!("bump map '{file}': {e}; taken as a height map"));
+            return false;
+        }
+    };
+    classify_normal_map(&img)
+}
+
+/// The colour test of [`looks_like_normal_map`], on at most about a million sampled pixels.
+pub(crate) fn classify_normal_map(img: &image::DynamicImage) -> bool {
+    use image::GenericImageView as _;
     if !img.color().has_color() {
         return false;
     }
-    let rgb = img.to_rgb8();
-    let n = (rgb.width() as u64 * rgb.height() as u64).max(1) as f64;
-    let (mut sr, mut sg, mut sb, mut grey) = (0.0, 0.0, 0.0, 0u64);
-    for p in rgb.pixels() {
-        sr += p[0] as f64;
-        sg += p[1] as f64;
-        sb += p[2] as f64;
-        if p[0] == p[1] && p[1] == p[2] {
-            grey += 1;
+    let (w, h) = img.dimensions();
+    let step = ((w as u64 * h as u64) as f64 / 1_048_576.0).sqrt().ceil().max(1.0) as u32;
+    let (mut sr, mut sg, mut sb, mut grey, mut n) = (0.0, 0.0, 0.0, 0u64, 0u64);
+    for y in (0..h).step_by(step as usize) {
+        for x in (0..w).step_by(step as usize) {
+            let p = img.get_pixel(x, y);
+            // 8-bit view of any sample type.
+            let (r, g, b) = (p[0], p[1], p[2]);
+            sr += r as f64;
+            sg += g as f64;
+            sb += b as f64;
+            n += 1;
+            if r == g && g == b {
+                grey += 1;
+            }
         }
     }
+    let n = n.max(1) as f64;
     let (r, g, b) = (sr / n / 255.0, sg / n / 255.0, sb / n / 255.0);
     (grey as f64) < 0.9 * n && b > 0.6 && (r - 0.5).abs() < 0.2 && (g - 0.5).abs() < 0.2
 }
@@ -320,4 +371,32 @@ pub fn flip_uvs_to_gltf(scene: &Scene) -> Result<Scene> {
     }
     out.uv_v_up = false;
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn face_normals_are_scale_free() {
+        for s in [1e-30f32, 1e-20, 1e-6, 1.0, 1e6, 1e30] {
+            let n = face_normal(Vec3::ZERO, Vec3::new(s, 0.0, 0.0), Vec3::new(0.0, s, 0.0));
+            let n = n.unwrap_or_else(|| panic!("scale {s}: no normal"));
+            assert!((n - Vec3::Z).length() < 1e-6, "scale {s}: {n:?}");
+        }
+        // Sliver: 1e-7 high over a unit base.
+        let n = face_normal(Vec3::ZERO, Vec3::X, Vec3::new(0.5, 1e-7, 0.0)).unwrap();
+        assert!((n - Vec3::Z).length() < 1e-6, "{n:?}");
+        assert_eq!(face_normal(Vec3::ZERO, Vec3::X, Vec3::X * 2.0), None);
+        assert_eq!(face_normal(Vec3::ONE, Vec3::ONE, Vec3::ONE), None);
+    }
+
+    #[test]
+    fn scaling_by_powers_of_two_is_exact() {
+        let v = Vec3::new(0.3, -1.7, 2.9);
+        let a = v.cross(Vec3::new(1.1, 0.2, -0.4)).normalize();
+        let b = pow2_scaled(pow2_scaled(v).cross(pow2_scaled(Vec3::new(1.1, 0.2, -0.4)))).normalize();
+        assert_eq!(a, b);
+    }
 }

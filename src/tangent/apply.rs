@@ -38,6 +38,10 @@ pub fn needs_tangents(scene: &Scene, r: PrimRef, all: bool) -> std::result::Resu
     if !(4..=6).contains(&mode) {
         return Err(format!("not triangles (mode {mode})"));
     }
+    if pj.pointer("/attributes/POSITION").is_none() {
+        // glTF lets a primitive leave POSITION out (clients skip drawing it); there is no surface.
+        return Err("no POSITION (nothing to draw)".into());
+    }
     if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
         return Err("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".into());
     }

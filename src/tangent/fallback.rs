@@ -1,14 +1,45 @@
 //! Making every frame usable. MikkTSpace has no answer for some corners (degenerate triangles
 //! with no neighbour to borrow from) and can give frames that are not orthogonal to a normal that
-//! is not unit length. Each such corner gets a unit tangent orthogonal to its normal, borrowed from
-//! a neighbour where one exists (keeping its handedness), otherwise built from the axis least
-//! aligned with the normal. Every substitution is counted.
+//! is not unit length. Each such corner gets a substitute frame, and every substitution is counted
+//! with its reason ([`FallbackCounts`]: `undefined` when the reference gave nothing, `invalid` when
+//! what it gave was unusable).
+//!
+//! The substitute frame, in order of preference:
+//! 1. the tangent of another corner of the same triangle with a valid frame, then of the first
+//!    corner with a valid frame at the same vertex, projected onto the plane orthogonal to this
+//!    corner's normal (Gram-Schmidt) and normalised, keeping the lender's `w`;
+//! 2. otherwise the coordinate axis least aligned with the normal, projected the same way, with
+//!    the reference's `w` if it gave one and `+1` if not.
+//!
+//! Every test is relative to the vectors' own scale: vectors are divided by their largest
+//! component before they are normalised, so a frame or normal of length 1e-30 (a microscopic
+//! triangle's unnormalised cross product) is treated like one of length 1, and a projection is
+//! refused only when what is left of the tangent is below [`PARALLEL_TOLERANCE`] of its length.
+//! The only absolute tolerances are those for frames that are already meant to be unit
+//! ([`UNIT_TOLERANCE`], [`ORTHO_TOLERANCE`]).
 
 use glam::Vec3;
 
 /// Tolerances a frame must meet to leave the tool unchanged.
 pub const UNIT_TOLERANCE: f32 = 1e-4;
 pub const ORTHO_TOLERANCE: f32 = 1e-3;
+/// A tangent whose component orthogonal to the normal is shorter than this fraction of its own
+/// length is taken as parallel to the normal (about 0.06 degrees from it).
+pub const PARALLEL_TOLERANCE: f32 = 1e-3;
+
+/// `v` scaled to unit length, whatever its magnitude (tiny or huge vectors do not underflow or
+/// overflow), or `None` when it is zero or not finite.
+pub fn unit(v: Vec3) -> Option<Vec3> {
+    if !v.is_finite() {
+        return None;
+    }
+    let m = v.abs().max_element();
+    if m == 0.0 {
+        return None;
+    }
+    let u = (v / m).normalize();
+    u.is_finite().then_some(u)
+}
 
 /// Why corners were given a substitute frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
@@ -35,28 +66,24 @@ impl FallbackCounts {
 /// True when `t` is a frame the conventions accept for normal `n`.
 pub fn is_valid(t: [f32; 4], n: Vec3) -> bool {
     let v = Vec3::new(t[0], t[1], t[2]);
-    let n = n.normalize_or_zero();
-    v.is_finite()
-        && (v.length() - 1.0).abs() <= UNIT_TOLERANCE
-        && (t[3] == 1.0 || t[3] == -1.0)
-        && n != Vec3::ZERO
-        && v.dot(n).abs() <= ORTHO_TOLERANCE
+    let Some(n) = unit(n) else { return false };
+    v.is_finite() && (v.length() - 1.0).abs() <= UNIT_TOLERANCE && (t[3] == 1.0 || t[3] == -1.0) && v.dot(n).abs() <= ORTHO_TOLERANCE
 }
 
-/// The unit vector orthogonal to `n` nearest to `t`, if `t` is far enough from parallel.
+/// The unit vector orthogonal to `n` nearest to `t`, if `t` is far enough from parallel
+/// ([`PARALLEL_TOLERANCE`], relative to `t`'s length). Scale-free in both `t` and `n`; a zero or
+/// non-finite `n` has no orthogonal plane and gives `None`.
 pub fn orthogonalise(t: Vec3, n: Vec3) -> Option<Vec3> {
-    let n = n.normalize_or_zero();
+    let n = unit(n)?;
+    let t = unit(t)?;
     let p = t - n * n.dot(t);
     let len = p.length();
-    (len.is_finite() && len > 1e-3 * t.length().max(f32::MIN_POSITIVE)).then(|| p / len).filter(|v| v.is_finite())
+    (len > PARALLEL_TOLERANCE).then(|| p / len).filter(|v| v.is_finite())
 }
 
 /// A unit vector orthogonal to `n`, from the coordinate axis least aligned with it.
 pub fn any_orthogonal(n: Vec3) -> Vec3 {
-    let n = n.normalize_or_zero();
-    if n == Vec3::ZERO || !n.is_finite() {
-        return Vec3::X;
-    }
+    let Some(n) = unit(n) else { return Vec3::X };
     let a = n.abs();
     let axis = if a.x <= a.y && a.x <= a.z {
         Vec3::X
@@ -143,6 +170,61 @@ mod tests {
         }
         assert_eq!(c.undefined, 3);
         assert_eq!(c.borrowed, 0);
+    }
+
+    #[test]
+    fn thresholds_are_relative_to_scale() {
+        // A microscopic triangle's unnormalised normal and tangent: still a valid frame.
+        let n = Vec3::new(0.0, 0.0, 1e-30);
+        assert_eq!(unit(n), Some(Vec3::Z));
+        assert_eq!(orthogonalise(Vec3::new(1e-25, 0.0, 1e-25), n), Some(Vec3::X));
+        assert!(is_valid([1.0, 0.0, 0.0, 1.0], n));
+        assert_eq!(any_orthogonal(n), Vec3::X);
+        // Huge vectors do not overflow.
+        let big = Vec3::new(3e38, 3e38, 0.0);
+        assert!((unit(big).unwrap().length() - 1.0).abs() < 1e-6);
+        assert!(orthogonalise(big, Vec3::Z).is_some());
+        // Nearly parallel (within the tolerance) is parallel, whatever the length.
+        assert_eq!(orthogonalise(Vec3::new(1e-4, 0.0, 1.0) * 1e-20, Vec3::Z), None);
+        assert!(orthogonalise(Vec3::new(1e-2, 0.0, 1.0) * 1e-20, Vec3::Z).is_some());
+        assert_eq!(unit(Vec3::ZERO), None);
+        assert_eq!(unit(Vec3::new(f32::NAN, 0.0, 1.0)), None);
+        assert_eq!(orthogonalise(Vec3::X, Vec3::ZERO), None);
+    }
+
+    #[test]
+    fn reasons_are_counted_apart_and_w_follows_the_lender_or_the_reference() {
+        let n = Vec3::Z;
+        // Triangle 0: one valid corner (w = -1), one undefined, one non-unit.
+        // Triangle 1: every corner invalid (NaN, w = -1) and no valid corner at its vertices.
+        let mut f = vec![
+            Some([0.0, 1.0, 0.0, -1.0]),
+            None,
+            Some([2.0, 0.0, 0.0, 1.0]),
+            Some([f32::NAN, 0.0, 0.0, -1.0]),
+            Some([f32::NAN, 0.0, 0.0, -1.0]),
+            None,
+        ];
+        let (out, c) = repair(&mut f, &[n; 6], &[0, 1, 2, 3, 4, 5]);
+        assert_eq!(c, FallbackCounts { undefined: 2, invalid: 3, borrowed: 2 });
+        assert_eq!(out[1], [0.0, 1.0, 0.0, -1.0]);
+        assert_eq!(out[2], [0.0, 1.0, 0.0, -1.0]);
+        assert_eq!(out[3], [1.0, 0.0, 0.0, -1.0], "fixed axis, the reference's w");
+        assert_eq!(out[5], [1.0, 0.0, 0.0, 1.0], "fixed axis, +1 without a reference w");
+        for t in out {
+            assert!(is_valid(t, n));
+        }
+    }
+
+    #[test]
+    fn lender_across_triangles_at_the_same_vertex() {
+        let n = Vec3::Y;
+        let mut f = vec![Some([1.0, 0.0, 0.0, 1.0]), None, None, None, None, None];
+        // Corner 4 is vertex 0 again: it borrows corner 0's frame through the vertex.
+        let (out, c) = repair(&mut f, &[n; 6], &[0, 1, 2, 3, 0, 5]);
+        assert_eq!(out[4], [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(c.undefined, 5);
+        assert_eq!(c.borrowed, 3);
     }
 
     #[test]

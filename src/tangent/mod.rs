@@ -55,7 +55,9 @@ pub fn primitive_with_tangents(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: 
 /// [`primitive_with_tangents`], with what it did.
 pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
     let uv_name = format!("TEXCOORD_{uv_set}");
-    let positions = p.positions();
+    let mut positions = p.positions();
+    // Without POSITION (callers skip such primitives) the surface is a point.
+    positions.resize(p.vertex_count(), [0.0; 3]);
     let uvs: Vec<[f32; 2]> = p.attr(&uv_name).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
     let (mut corners, targets) = unweld(p);
     corners.retain(|(n, _)| n != "TANGENT" && n != "_BITANGENT");
@@ -78,9 +80,9 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
         let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
         let cu: Vec<[f32; 2]> = p.indices.iter().map(|&i| uvs[i as usize]).collect();
         let idx: Vec<u32> = (0..p.indices.len() as u32).collect();
-        mikk::generate(&TriMesh { positions: &cp, normals: &mesh_normals, uvs: &cu, indices: &idx }, opts.engine)
+        generate_with_stack(&TriMesh { positions: &cp, normals: &mesh_normals, uvs: &cu, indices: &idx }, opts.engine)
     } else {
-        mikk::generate(&TriMesh { positions: &positions, normals: &mesh_normals, uvs: &uvs, indices: &p.indices }, opts.engine)
+        generate_with_stack(&TriMesh { positions: &positions, normals: &mesh_normals, uvs: &uvs, indices: &p.indices }, opts.engine)
     };
     let flip = if uv_v_up { 1.0 } else { -1.0 };
     let mut frames: Vec<Option<[f32; 4]>> = frames.into_iter().map(|f| f.map(|t| [t[0], t[1], t[2], t[3] * flip])).collect();
@@ -105,4 +107,33 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
         fallback,
     };
     (out, stats)
+}
+
+/// Stack bytes the reference needs per triangle around one vertex, with a wide margin.
+const STACK_PER_TRIANGLE: usize = 1024;
+
+/// [`mikk::generate`] with enough stack. The reference groups the triangles around each vertex
+/// recursively, one stack frame per triangle: 20 000 triangles on one vertex overflow a 2 MiB
+/// worker stack and abort the process. When the mesh has a vertex position shared by more than
+/// a thousand corners, generation runs on a thread whose stack grows with that count.
+fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> Vec<Option<[f32; 4]>> {
+    let mut per_position: std::collections::HashMap<[u32; 3], usize> = std::collections::HashMap::new();
+    let mut most = 0;
+    for &i in mesh.indices {
+        let p = mesh.positions[i as usize];
+        let n = per_position.entry([p[0].to_bits(), p[1].to_bits(), p[2].to_bits()]).or_insert(0);
+        *n += 1;
+        most = most.max(*n);
+    }
+    if most <= 1000 {
+        return mikk::generate(mesh, engine);
+    }
+    let stack = (4 << 20) + most * STACK_PER_TRIANGLE;
+    std::thread::scope(|s| {
+        match std::thread::Builder::new().name("mikktspace".into()).stack_size(stack).spawn_scoped(s, || mikk::generate(mesh, engine)) {
+            Ok(h) => h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)),
+            // No thread to be had: try on this one.
+            Err(_) => mikk::generate(mesh, engine),
+        }
+    })
 }

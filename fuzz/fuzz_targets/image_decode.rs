@@ -1,0 +1,11 @@
+#![no_main]
+//! Image bytes through the guarded decoder every command that reads pixels uses.
+use bumpbake::scene::image_limits;
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(img) = image_limits::decode(data) {
+        assert!(img.width() > 0 && img.height() > 0);
+        assert!(img.width() as u64 * img.height() as u64 <= image_limits::MAX_PIXELS);
+    }
+});

@@ -1,0 +1,44 @@
+//! Every input a fuzz target ever crashed on (`fuzz/regressions/TARGET/`), replayed through the
+//! same steps as the target, so a fixed crash stays fixed without a nightly toolchain.
+
+use bumpbake::scene::{ReadOptions, Scene, WriteOptions};
+use bumpbake::tangent::apply::{apply, ApplyOptions};
+use std::path::{Path, PathBuf};
+
+fn inputs(target: &str) -> Vec<PathBuf> {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions").join(target);
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&d).map(|r| r.map(|e| e.unwrap().path()).collect()).unwrap_or_default();
+    v.sort();
+    v
+}
+
+fn exercise(path: &str, data: &[u8]) {
+    let Ok(mut scene) = Scene::read_bytes(Path::new(path), data, &ReadOptions::default()) else { return };
+    for r in scene.primitives() {
+        let _ = scene.primitive(r);
+    }
+    if apply(&mut scene, &ApplyOptions { all: true, ..Default::default() }).is_ok() {
+        let _ = bumpbake::scene::write(&scene, Path::new("/nonexistent-bumpbake-fuzz/out.glb"), &WriteOptions::default());
+    }
+}
+
+#[test]
+fn gltf_read_regressions() {
+    for f in inputs("gltf_read") {
+        exercise("/nonexistent-bumpbake-fuzz/in.gltf", &std::fs::read(&f).unwrap());
+    }
+}
+
+#[test]
+fn obj_read_regressions() {
+    for f in inputs("obj_read") {
+        exercise("/nonexistent-bumpbake-fuzz/in.obj", &std::fs::read(&f).unwrap());
+    }
+}
+
+#[test]
+fn image_decode_regressions() {
+    for f in inputs("image_decode") {
+        let _ = bumpbake::scene::image_limits::decode(&std::fs::read(&f).unwrap());
+    }
+}
