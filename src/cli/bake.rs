@@ -2,7 +2,7 @@
 
 use bumpbake::bake::maps::HeightSettings;
 use bumpbake::bake::{run as run_job, BakeJob, BakeReport, MapSource};
-use bumpbake::batch::{self, BatchOptions};
+use bumpbake::batch;
 use bumpbake::normalmap::{Channel, Convention, Filter};
 use bumpbake::scene::{ReadOptions, WriteOptions};
 use bumpbake::{Error, Result};
@@ -20,9 +20,6 @@ pub struct Args {
     /// Output (one input): .glb or .gltf.
     #[arg(short, long, conflicts_with = "out_dir")]
     pub output: Option<PathBuf>,
-    /// Output folder (any number of inputs).
-    #[arg(long)]
-    pub out_dir: Option<PathBuf>,
     /// Extension of outputs written into --out-dir.
     #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
     pub out_ext: String,
@@ -74,25 +71,15 @@ pub struct Args {
     /// Write a Make/Ninja depfile listing every input read (one input).
     #[arg(long)]
     pub depfile: Option<PathBuf>,
-    /// Files processed at once (default: one per core).
-    #[arg(short, long, default_value_t = 0)]
-    pub jobs: usize,
-    /// One JSON record per file on stdout.
-    #[arg(long)]
-    pub json: bool,
-    /// Show a progress bar even when not on a terminal.
-    #[arg(long)]
-    pub progress: bool,
-    /// No report on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub batch: super::report::BatchArgs,
 }
 
 pub fn run(a: Args) -> Result<u8> {
     if a.depfile.is_some() && a.inputs.len() > 1 {
         return Err(Error::usage("--depfile takes one input"));
     }
-    let outputs = super::report::outputs(&a.inputs, &a.output, &a.out_dir, &a.out_ext)?;
+    let outputs = super::report::outputs(&a.inputs, &a.output, &a.batch.out_dir, &a.out_ext)?;
     let strength = match (a.height_range, a.texel_size) {
         (Some(r), Some(t)) if t > 0.0 && r.is_finite() && t.is_finite() => r / t,
         (Some(_), Some(_)) => return Err(Error::usage("--texel-size must be a positive number")),
@@ -118,7 +105,7 @@ pub fn run(a: Args) -> Result<u8> {
         write: WriteOptions { images_external: a.images == "external", ..Default::default() },
         depfile: a.depfile.clone(),
     };
-    let opts = BatchOptions { jobs: a.jobs, force_progress: a.progress, quiet: a.quiet || a.json };
+    let opts = a.batch.options();
     let results = batch::run(&a.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.inputs, &outputs, input))))?;
-    super::report::print(&a.inputs, results, a.json, a.quiet, BakeReport::text)
+    super::report::print(&a.inputs, results, a.batch.json, a.batch.quiet, BakeReport::text)
 }

@@ -7,7 +7,7 @@ use bumpbake::normalmap::{
 use bumpbake::{Error, Result};
 use clap::builder::TypedValueParser;
 use std::io::IsTerminal;
-use bumpbake::batch::{self, BatchOptions};
+use bumpbake::batch;
 use std::path::{Path, PathBuf};
 
 /// What alpha holds.
@@ -29,24 +29,9 @@ pub struct Args {
     /// Normal map to write (one input): .png (8 or 16-bit), .tif, or .exr (32-bit float).
     #[arg(short, long, value_name = "NORMAL", conflicts_with = "out_dir")]
     pub output: Option<PathBuf>,
-    /// Output folder (any number of inputs); names follow the inputs.
-    #[arg(long)]
-    pub out_dir: Option<PathBuf>,
     /// Extension of the outputs written into --out-dir.
     #[arg(long, value_parser = ["png", "tif", "exr"], default_value = "png")]
     pub out_ext: String,
-    /// Files processed at once (default: one per core).
-    #[arg(short, long, default_value_t = 0)]
-    pub jobs: usize,
-    /// One JSON record per file on stdout (JSON Lines).
-    #[arg(long)]
-    pub json: bool,
-    /// No messages on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
-    /// Show a progress bar even when not on a terminal.
-    #[arg(long)]
-    pub progress: bool,
     /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
     #[arg(long, value_enum, default_value_t = Channel::Luma)]
     pub channel: Channel,
@@ -90,6 +75,8 @@ pub struct Args {
     /// Refuse images whose header claims more pixels than this.
     #[arg(long, default_value_t = nm::DEFAULT_MAX_PIXELS)]
     pub max_pixels: u64,
+    #[command(flatten)]
+    pub batch: super::report::BatchArgs,
 }
 
 fn strength(args: &Args) -> Result<f32> {
@@ -127,7 +114,7 @@ struct Record {
 }
 
 pub fn run(args: Args) -> Result<u8> {
-    let outputs = super::report::outputs(&args.heights, &args.output, &args.out_dir, &args.out_ext)?;
+    let outputs = super::report::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
     let options = Options {
         strength: strength(&args)?,
         filter: args.filter,
@@ -158,7 +145,7 @@ pub fn run(args: Args) -> Result<u8> {
         bar.finish_and_clear();
         vec![r]
     } else {
-        let opts = BatchOptions { jobs: args.jobs, force_progress: args.progress, quiet: args.quiet || args.json };
+        let opts = args.batch.options();
         batch::run(&args.heights, &opts, |input| convert(input, super::report::paired(&args.heights, &outputs, input)).and_then(|c| nm::convert_file(&c, None)))?
     };
     let records: Vec<Result<Record>> = results
@@ -166,7 +153,7 @@ pub fn run(args: Args) -> Result<u8> {
         .zip(args.heights.iter().zip(&outputs))
         .map(|(r, (i, o))| r.map(|t| Record { input: i.clone(), output: o.clone(), timings_ms: t }))
         .collect();
-    super::report::print(&args.heights, records, args.json, args.quiet, |r| {
+    super::report::print(&args.heights, records, args.batch.json, args.batch.quiet, |r| {
         if args.heights.len() > 1 {
             format!("{} -> {}\n", r.input.display(), r.output.display())
         } else {
@@ -180,7 +167,7 @@ fn progress_bar(args: &Args) -> indicatif::ProgressBar {
     let ci = std::env::var("CI")
         .map(|v| v == "true" || v == "1")
         .unwrap_or(false);
-    if args.quiet || (!args.progress && (ci || !std::io::stderr().is_terminal())) {
+    if args.batch.quiet || (!args.batch.progress && (ci || !std::io::stderr().is_terminal())) {
         return indicatif::ProgressBar::hidden();
     }
     // The header is read again by the conversion; this costs microseconds and keeps the

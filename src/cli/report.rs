@@ -1,9 +1,35 @@
 //! Printing per-file results the same way for every command that takes many inputs: a JSON
 //! Lines record per file (`status` ok or error), or text on stderr, and a summary for batches.
 
-use bumpbake::batch;
+use bumpbake::batch::{self, BatchOptions};
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
+
+/// The options every command over many inputs shares.
+#[derive(clap::Args, Debug)]
+pub struct BatchArgs {
+    /// Output folder (any number of inputs); names follow the inputs.
+    #[arg(long)]
+    pub out_dir: Option<PathBuf>,
+    /// Files processed at once (default: one per core).
+    #[arg(short, long, default_value_t = 0)]
+    pub jobs: usize,
+    /// Print one JSON record per file on stdout (JSON Lines).
+    #[arg(long)]
+    pub json: bool,
+    /// Show a progress bar even when not on a terminal.
+    #[arg(long)]
+    pub progress: bool,
+    /// No report on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl BatchArgs {
+    pub fn options(&self) -> BatchOptions {
+        BatchOptions { jobs: self.jobs, force_progress: self.progress, quiet: self.quiet || self.json }
+    }
+}
 
 /// Output paths for the inputs: `-o` for one input, or names derived into `--out-dir`.
 pub fn outputs(inputs: &[PathBuf], output: &Option<PathBuf>, out_dir: &Option<PathBuf>, ext: &str) -> Result<Vec<PathBuf>> {

@@ -1,6 +1,6 @@
 //! `bumpbake tangents IN... -o OUT | --out-dir DIR`.
 
-use bumpbake::batch::{self, BatchOptions};
+use bumpbake::batch;
 use bumpbake::scene::{NormalMode, ReadOptions, WriteOptions};
 use bumpbake::tangent::apply::ApplyOptions;
 use bumpbake::tangent::command::{run as run_job, TangentsJob, TangentsReport};
@@ -20,9 +20,6 @@ pub struct Args {
     /// Output file (one input): .gltf (with a .bin beside it) or .glb.
     #[arg(short, long, conflicts_with = "out_dir")]
     pub output: Option<PathBuf>,
-    /// Output folder (any number of inputs); names follow the inputs.
-    #[arg(long)]
-    pub out_dir: Option<PathBuf>,
     /// Extension of the outputs written into --out-dir.
     #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
     pub out_ext: String,
@@ -47,18 +44,8 @@ pub struct Args {
     /// Write a Make/Ninja depfile (one input) listing every file read.
     #[arg(long)]
     pub depfile: Option<PathBuf>,
-    /// Files processed at once (default: one per core).
-    #[arg(short, long, default_value_t = 0)]
-    pub jobs: usize,
-    /// Print one JSON record per file on stdout (JSON Lines).
-    #[arg(long)]
-    pub json: bool,
-    /// Show a progress bar even when not on a terminal.
-    #[arg(long)]
-    pub progress: bool,
-    /// No report on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub batch: super::report::BatchArgs,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -71,7 +58,7 @@ pub fn run(a: Args) -> Result<u8> {
     if a.depfile.is_some() && a.inputs.len() > 1 {
         return Err(Error::usage("--depfile takes one input"));
     }
-    let outputs = super::report::outputs(&a.inputs, &a.output, &a.out_dir, &a.out_ext)?;
+    let outputs = super::report::outputs(&a.inputs, &a.output, &a.batch.out_dir, &a.out_ext)?;
     let job = |input: &Path, output: &Path| TangentsJob {
         input: input.to_path_buf(),
         output: output.to_path_buf(),
@@ -86,7 +73,7 @@ pub fn run(a: Args) -> Result<u8> {
         write: WriteOptions { embed: a.embed, ..Default::default() },
         depfile: a.depfile.clone(),
     };
-    let opts = BatchOptions { jobs: a.jobs, force_progress: a.progress, quiet: a.quiet || a.json };
+    let opts = a.batch.options();
     let results = batch::run(&a.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.inputs, &outputs, input))))?;
-    super::report::print(&a.inputs, results, a.json, a.quiet, TangentsReport::text)
+    super::report::print(&a.inputs, results, a.batch.json, a.batch.quiet, TangentsReport::text)
 }
