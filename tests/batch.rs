@@ -15,7 +15,12 @@ fn one_corrupt_file_among_good_ones() {
     let lines: Vec<serde_json::Value> = String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(lines.len(), 3, "one record per file, in input order");
     assert_eq!(lines[0]["status"], "ok");
+    assert!(lines.iter().all(|l| l["schema"] == "bumpbake-tangents/1"), "every record names its schema");
     assert_eq!(lines[0]["generated"], 1);
+    for key in ["input", "output", "primitives", "kept", "skipped", "vertices_in", "vertices_out", "fallback_frames", "notes", "written", "timings_ms"] {
+        assert!(lines[0].get(key).is_some(), "documented field {key}");
+    }
+    assert_eq!(lines[1]["exit_code"], 2);
     assert_eq!(lines[1]["status"], "error");
     assert!(lines[1]["error"].as_str().unwrap().contains("b.glb"));
     assert_eq!(lines[2]["status"], "ok");

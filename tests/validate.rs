@@ -422,6 +422,39 @@ fn green_channel_convention_on_height_fields() {
     assert!(conf < 0.5, "separable relief gives no evidence: {conf}");
 }
 
+/// The maps `bumpbake normalmap` makes from six height fields: OpenGL as made, DirectX with
+/// `--convention directx`, as `bumpbake validate` reads them from the files.
+#[test]
+fn normalmap_output_is_recognised_in_both_conventions() {
+    type Field = Box<dyn Fn(f64, f64) -> f64>;
+    let fields: Vec<(&str, Field)> = vec![
+        ("sine product", Box::new(|x, y| 0.5 + 0.4 * (x / 7.0).sin() * (y / 5.0).cos())),
+        ("gaussian bump", Box::new(|x, y| 0.1 + 0.8 * (-((x - 40.0).powi(2) + (y - 25.0).powi(2)) / 200.0).exp())),
+        ("ripple", Box::new(|x, y| 0.5 + 0.3 * (((x - 32.0).powi(2) + (y - 32.0).powi(2)).sqrt() / 3.0).sin())),
+        ("saddle", Box::new(|x, y| 0.5 + (x - 32.0) * (y - 32.0) / 2500.0)),
+        ("egg crate with slope", Box::new(|x, y| 0.3 + 0.1 * (x / 3.0).sin() * (y / 4.0).sin() + 0.004 * x + 0.002 * y)),
+        ("two bumps and a dent", Box::new(|x, y| {
+            let g = |cx: f64, cy: f64, r: f64| (-((x - cx).powi(2) + (y - cy).powi(2)) / (r * r)).exp();
+            0.4 + 0.4 * g(20.0, 20.0, 8.0) + 0.2 * g(45.0, 40.0, 5.0) - 0.3 * g(30.0, 50.0, 10.0)
+        })),
+    ];
+    let d = scratch_dir("validate_nm_conventions");
+    for (k, (name, h)) in fields.iter().enumerate() {
+        let height = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(64, 64, |x, y| image::Luma([(h(x as f64, y as f64).clamp(0.0, 1.0) * 65535.0).round() as u16]));
+        let hp = d.join(format!("h{k}.png"));
+        height.save(&hp).unwrap();
+        for (conv, want) in [("opengl", "opengl"), ("directx", "directx")] {
+            let np = d.join(format!("n{k}_{conv}.png"));
+            let o = run(&["normalmap", s(&hp), "-o", s(&np), "--strength", "40", "--convention", conv]);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            let (_, r) = validate(&[s(&np), "--image-convention", conv]);
+            let c = &r["files"][0]["subjects"][0]["convention"];
+            assert_eq!(c["convention"], want, "{name} made {conv}: {c}");
+            assert!(c["confidence"].as_f64().unwrap() > 0.8, "{name} {conv}: {c}");
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Khronos sample models
 

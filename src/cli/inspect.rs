@@ -25,7 +25,9 @@ pub fn run(a: Args) -> Result<u8> {
     for input in &a.inputs {
         let i = bumpbake::inspect::inspect(input, &opts)?;
         if a.json {
-            println!("{}", serde_json::to_string(&i).expect("serialises"));
+            let mut v = serde_json::to_value(&i).expect("serialises");
+            v["schema"] = serde_json::json!("bumpbake-inspect/1");
+            println!("{v}");
         } else {
             print!("{}", i.text());
         }

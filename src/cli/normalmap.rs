@@ -153,7 +153,7 @@ pub fn run(args: Args) -> Result<u8> {
         .zip(args.heights.iter().zip(&outputs))
         .map(|(r, (i, o))| r.map(|t| Record { input: i.clone(), output: o.clone(), timings_ms: t }))
         .collect();
-    super::report::print(&args.heights, records, args.batch.json, args.batch.quiet, |r| {
+    super::report::print("bumpbake-normalmap/1", &args.heights, records, args.batch.json, args.batch.quiet, |r| {
         if args.heights.len() > 1 {
             format!("{} -> {}\n", r.input.display(), r.output.display())
         } else {

@@ -46,14 +46,16 @@ pub fn outputs(inputs: &[PathBuf], output: &Option<PathBuf>, out_dir: &Option<Pa
     Ok(outs)
 }
 
-/// Prints every result; returns the exit code. With one input its error is the command's error.
-pub fn print<R: serde::Serialize>(inputs: &[PathBuf], results: Vec<Result<R>>, json: bool, quiet: bool, text: impl Fn(&R) -> String) -> Result<u8> {
+/// Prints every result; returns the exit code. `schema` names the record layout
+/// (`docs/json.md`). With one input its error is the command's error.
+pub fn print<R: serde::Serialize>(schema: &str, inputs: &[PathBuf], results: Vec<Result<R>>, json: bool, quiet: bool, text: impl Fn(&R) -> String) -> Result<u8> {
     let single = inputs.len() == 1;
     let mut failed = Vec::new();
     for (input, r) in inputs.iter().zip(results) {
         match r {
             Ok(rep) if json => {
                 let mut v = serde_json::to_value(&rep).expect("report serialises");
+                v["schema"] = serde_json::json!(schema);
                 v["status"] = serde_json::json!("ok");
                 println!("{v}");
             }
@@ -65,7 +67,7 @@ pub fn print<R: serde::Serialize>(inputs: &[PathBuf], results: Vec<Result<R>>, j
             Err(e) if single => return Err(e),
             Err(e) => {
                 if json {
-                    println!("{}", serde_json::json!({ "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() }));
+                    println!("{}", serde_json::json!({ "schema": schema, "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() }));
                 }
                 if !quiet {
                     eprintln!("bumpbake: {e}");

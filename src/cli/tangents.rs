@@ -75,5 +75,5 @@ pub fn run(a: Args) -> Result<u8> {
     };
     let opts = a.batch.options();
     let results = batch::run(&a.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.inputs, &outputs, input))))?;
-    super::report::print(&a.inputs, results, a.batch.json, a.batch.quiet, TangentsReport::text)
+    super::report::print("bumpbake-tangents/1", &a.inputs, results, a.batch.json, a.batch.quiet, TangentsReport::text)
 }
