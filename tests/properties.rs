@@ -3,7 +3,7 @@
 //!   for arbitrary finite meshes (degenerate, tiny, huge, repeated indices, any normals);
 //! - split/merge (`weld`/`unweld`) keeps every corner's attributes.
 
-use bumpbake::scene::weld::{unweld, weld};
+use bumpbake::scene::weld::{unweld, weld, weld_from};
 use bumpbake::scene::{Primitive, Stream};
 use bumpbake::tangent::{primitive_with_stats, Options};
 use glam::Vec3;
@@ -105,6 +105,8 @@ proptest! {
             prop_assert_eq!(&s1.data, &s2.data, "{} per corner", n1);
         }
         prop_assert_eq!(targets[0][0].1.data.clone(), again_t[0][0].1.data.clone());
+        // Told where each corner came from, the weld takes a shortcut and must end the same.
+        prop_assert_eq!(&weld_from(corners.clone(), targets.clone(), 4, Some(&idx)), &w);
         // Merged: no two output vertices are equal in every attribute.
         let mut seen = std::collections::HashSet::new();
         for v in 0..w.vertex_count() {

@@ -9,7 +9,7 @@ pub mod fallback;
 pub mod fast;
 pub mod mikk;
 
-use crate::scene::weld::{unweld, weld};
+use crate::scene::weld::{unweld, weld_from};
 use crate::scene::{flat_normals, Primitive, Stream};
 use fallback::FallbackCounts;
 use glam::Vec3;
@@ -98,7 +98,7 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
             .collect();
         corners.push(("_BITANGENT".into(), Stream::from_f32("VEC3", &b)));
     }
-    let out = weld(corners, targets, 4);
+    let out = weld_from(corners, targets, 4, Some(&p.indices));
     let stats = FrameStats {
         vertices_in: p.vertex_count(),
         vertices_out: out.vertex_count(),
@@ -116,7 +116,11 @@ const STACK_PER_TRIANGLE: usize = 1024;
 /// recursively, one stack frame per triangle: 20 000 triangles on one vertex overflow a 2 MiB
 /// worker stack and abort the process. When the mesh has a vertex position shared by more than
 /// a thousand corners, generation runs on a thread whose stack grows with that count.
+/// Only the `bevy_mikktspace` engine recurses; ours walks groups with an explicit stack.
 fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> Vec<Option<[f32; 4]>> {
+    if engine != mikk::Engine::Bevy {
+        return mikk::generate(mesh, engine);
+    }
     let mut per_position: std::collections::HashMap<[u32; 3], usize> = std::collections::HashMap::new();
     let mut most = 0;
     for &i in mesh.indices {
