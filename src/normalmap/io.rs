@@ -90,14 +90,48 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
     let pick = super::height::pick(channel, ch, has_alpha, is_colour).map_err(|m| Error::input(path, m))?;
     let (w, h) = (w as usize, h as usize);
     let mut data = vec![0.0f32; w * h];
-    for out in data.chunks_exact_mut(w) {
-        let row = reader.next_row().map_err(bad)?.ok_or_else(|| Error::input(path, "cannot decode as PNG: rows missing"))?;
-        let raw = row.data();
-        match depth {
-            png::BitDepth::Sixteen => super::height::convert_row_be16(raw, ch, pick, out),
-            _ => super::height::convert_row(raw, ch, pick, |v| v as f32 / 255.0, out),
+    // Inflating is sequential; converting rows to heights is not. One thread inflates batches of
+    // rows while this one converts the previous batch, so conversion costs no wall time.
+    const BATCH: usize = 64;
+    let convert = |raw: &[u8], out: &mut [f32]| match depth {
+        png::BitDepth::Sixteen => super::height::convert_row_be16(raw, ch, pick, out),
+        _ => super::height::convert_row(raw, ch, pick, |v| v as f32 / 255.0, out),
+    };
+    std::thread::scope(|scope| -> Result<()> {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Result<(usize, Vec<u8>)>>(4);
+        scope.spawn(move || {
+            let mut row_len = 0;
+            for y0 in (0..h).step_by(BATCH) {
+                let mut buf = Vec::new();
+                for _ in y0..(y0 + BATCH).min(h) {
+                    match reader.next_row() {
+                        Ok(Some(row)) => {
+                            row_len = row.data().len();
+                            buf.extend_from_slice(row.data());
+                        }
+                        Ok(None) => {
+                            let _ = tx.send(Err(Error::input(path, "cannot decode as PNG: rows missing")));
+                            return;
+                        }
+                        Err(e) => {
+                            let _ = tx.send(Err(bad(e)));
+                            return;
+                        }
+                    }
+                }
+                if tx.send(Ok((row_len, buf))).is_err() {
+                    return;
+                }
+            }
+        });
+        for (rows, batch) in data.chunks_mut(w * BATCH).zip(rx.iter()) {
+            let (row_len, raw) = batch?;
+            for (out, r) in rows.chunks_exact_mut(w).zip(raw.chunks_exact(row_len.max(1))) {
+                convert(r, out);
+            }
         }
-    }
+        Ok(())
+    })?;
     Ok(Some(HeightPlane { width: w, height: h, data }))
 }
 
@@ -373,20 +407,36 @@ fn png_streamed(
         let mut stream = writer.stream_writer_with_size(1 << 20).map_err(one_line)?;
         let mut strips = super::encode::Strips::new(height, opts, enc);
         let mut be: Vec<u8> = Vec::new();
-        for y0 in (0..h).step_by(strip) {
-            let n = strip.min(h - y0);
-            let t0 = Instant::now();
-            strips.encode(y0, n, progress);
-            let t1 = Instant::now();
-            if sample_bytes == 2 {
-                be.clear();
-                be.extend(strips.u16s.iter().flat_map(|v| v.to_be_bytes()));
-                stream.write_all(&be).map_err(one_line)?;
-            } else {
-                stream.write_all(&strips.u8s).map_err(one_line)?;
-            }
-            filter_ms += (t1 - t0).as_secs_f64() * 1e3;
-            encode_ms += t1.elapsed().as_secs_f64() * 1e3;
+        // Strip k is compressed (one thread) while strip k + 1 is filtered (the others).
+        let starts: Vec<usize> = (0..h).step_by(strip).collect();
+        let (mut done_u8, mut done_u16): (Vec<u8>, Vec<u16>) = (Vec::new(), Vec::new());
+        let t0 = Instant::now();
+        strips.encode(0, strip.min(h), progress);
+        filter_ms += t0.elapsed().as_secs_f64() * 1e3;
+        for (k, _) in starts.iter().enumerate() {
+            std::mem::swap(&mut strips.u8s, &mut done_u8);
+            std::mem::swap(&mut strips.u16s, &mut done_u16);
+            let mut write = || -> std::result::Result<f64, String> {
+                let t = Instant::now();
+                if sample_bytes == 2 {
+                    be.clear();
+                    be.extend(done_u16.iter().flat_map(|v| v.to_be_bytes()));
+                    stream.write_all(&be).map_err(one_line)?;
+                } else {
+                    stream.write_all(&done_u8).map_err(one_line)?;
+                }
+                Ok(t.elapsed().as_secs_f64() * 1e3)
+            };
+            let (wrote, filtered) = match starts.get(k + 1) {
+                Some(&y) => rayon::join(write, || {
+                    let t = Instant::now();
+                    strips.encode(y, strip.min(h - y), progress);
+                    t.elapsed().as_secs_f64() * 1e3
+                }),
+                None => (write(), 0.0),
+            };
+            encode_ms += wrote?;
+            filter_ms += filtered;
         }
         let t1 = Instant::now();
         stream.finish().map_err(one_line)?;
