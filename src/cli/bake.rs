@@ -14,15 +14,8 @@ use std::path::{Path, PathBuf};
   bumpbake bake scene.gltf --height bumps.png --material Stone --strength 4 -o scene.glb
   bumpbake bake model.obj --normal normal_dx.png --convention directx -o model.gltf --images external")]
 pub struct Args {
-    /// Meshes: .obj (with its .mtl), .gltf or .glb.
-    #[arg(required = true)]
-    pub inputs: Vec<PathBuf>,
-    /// Output (one input): .glb or .gltf.
-    #[arg(short, long, conflicts_with = "out_dir")]
-    pub output: Option<PathBuf>,
-    /// Extension of outputs written into --out-dir.
-    #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
-    pub out_ext: String,
+    #[command(flatten)]
+    pub io: super::report::MeshIo,
     /// Height map to convert into the normal map.
     #[arg(long, conflicts_with = "normal")]
     pub height: Option<PathBuf>,
@@ -76,10 +69,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<u8> {
-    if a.depfile.is_some() && a.inputs.len() > 1 {
+    if a.depfile.is_some() && a.io.inputs.len() > 1 {
         return Err(Error::usage("--depfile takes one input"));
     }
-    let outputs = super::report::outputs(&a.inputs, &a.output, &a.batch.out_dir, &a.out_ext)?;
+    let outputs = super::report::outputs(&a.io.inputs, &a.io.output, &a.batch.out_dir, &a.io.out_ext)?;
     let strength = match (a.height_range, a.texel_size) {
         (Some(r), Some(t)) if t > 0.0 && r.is_finite() && t.is_finite() => r / t,
         (Some(_), Some(_)) => return Err(Error::usage("--texel-size must be a positive number")),
@@ -106,6 +99,6 @@ pub fn run(a: Args) -> Result<u8> {
         depfile: a.depfile.clone(),
     };
     let opts = a.batch.options();
-    let results = batch::run(&a.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.inputs, &outputs, input))))?;
-    super::report::print("bumpbake-bake/1", &a.inputs, results, a.batch.json, a.batch.quiet, BakeReport::text)
+    let results = batch::run(&a.io.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input))))?;
+    super::report::print("bumpbake-bake/1", &a.io.inputs, results, a.batch.json, a.batch.quiet, BakeReport::text)
 }

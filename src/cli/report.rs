@@ -5,6 +5,20 @@ use bumpbake::batch::{self, BatchOptions};
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
+/// Mesh inputs and where their outputs go, shared by `tangents` and `bake`.
+#[derive(clap::Args, Debug)]
+pub struct MeshIo {
+    /// Input meshes: .obj (with its .mtl), .gltf or .glb.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Output file (one input): .gltf (with a .bin beside it) or .glb.
+    #[arg(short, long, conflicts_with = "out_dir")]
+    pub output: Option<PathBuf>,
+    /// Extension of the outputs written into --out-dir.
+    #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
+    pub out_ext: String,
+}
+
 /// The options every command over many inputs shares.
 #[derive(clap::Args, Debug)]
 pub struct BatchArgs {

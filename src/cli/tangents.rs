@@ -14,15 +14,8 @@ use std::path::{Path, PathBuf};
   bumpbake tangents scene.gltf -o scene.gltf --overwrite --bitangents
   bumpbake tangents assets/*.glb --out-dir build/ -j 4 --json > report.jsonl")]
 pub struct Args {
-    /// Input meshes: .obj (with its .mtl), .gltf or .glb.
-    #[arg(required = true)]
-    pub inputs: Vec<PathBuf>,
-    /// Output file (one input): .gltf (with a .bin beside it) or .glb.
-    #[arg(short, long, conflicts_with = "out_dir")]
-    pub output: Option<PathBuf>,
-    /// Extension of the outputs written into --out-dir.
-    #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
-    pub out_ext: String,
+    #[command(flatten)]
+    pub io: super::report::MeshIo,
     /// Put buffers and images inside a .gltf as data URIs.
     #[arg(long)]
     pub embed: bool,
@@ -55,10 +48,10 @@ pub enum Normals {
 }
 
 pub fn run(a: Args) -> Result<u8> {
-    if a.depfile.is_some() && a.inputs.len() > 1 {
+    if a.depfile.is_some() && a.io.inputs.len() > 1 {
         return Err(Error::usage("--depfile takes one input"));
     }
-    let outputs = super::report::outputs(&a.inputs, &a.output, &a.batch.out_dir, &a.out_ext)?;
+    let outputs = super::report::outputs(&a.io.inputs, &a.io.output, &a.batch.out_dir, &a.io.out_ext)?;
     let job = |input: &Path, output: &Path| TangentsJob {
         input: input.to_path_buf(),
         output: output.to_path_buf(),
@@ -74,6 +67,6 @@ pub fn run(a: Args) -> Result<u8> {
         depfile: a.depfile.clone(),
     };
     let opts = a.batch.options();
-    let results = batch::run(&a.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.inputs, &outputs, input))))?;
-    super::report::print("bumpbake-tangents/1", &a.inputs, results, a.batch.json, a.batch.quiet, TangentsReport::text)
+    let results = batch::run(&a.io.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input))))?;
+    super::report::print("bumpbake-tangents/1", &a.io.inputs, results, a.batch.json, a.batch.quiet, TangentsReport::text)
 }
