@@ -37,14 +37,6 @@ impl Fx {
 
 /// Builds an indexed primitive from streams that hold one element per corner.
 pub fn weld(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)>>, mode: u32) -> Primitive {
-    weld_from(attributes, targets, mode, None)
-}
-
-/// [`weld`], told which vertex each corner was unwelded from. Corners of one original vertex are
-/// usually equal, so each is first compared with the vertices its origin already produced (a
-/// byte compare, no hashing); only a corner unlike all of them is looked up among all vertices.
-/// The result is the same as without `origin`.
-pub fn weld_from(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)>>, mode: u32, origin: Option<&[u32]>) -> Primitive {
     let all: Vec<&Stream> = attributes.iter().map(|(_, s)| s).chain(targets.iter().flatten().map(|(_, s)| s)).collect();
     let corners = all.first().map(|s| s.len()).unwrap_or(0);
     let stride: usize = all.iter().map(|s| s.format.elem_size()).sum();
@@ -54,45 +46,16 @@ pub fn weld_from(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, St
             keys.extend_from_slice(s.elem(c));
         }
     }
-    let key = |c: usize| &keys[c * stride..(c + 1) * stride];
-    let origin = origin.filter(|o| o.len() == corners);
-    let n_origins = origin.map(|o| o.iter().map(|&v| v as usize + 1).max().unwrap_or(0)).unwrap_or(0);
-    // Vertices made from each origin: the first inline, any further ones in a side table.
-    let mut made_first = vec![u32::MAX; n_origins];
-    let mut made_more: HashMap<u32, Vec<u32>, BuildHasherDefault<Fx>> = HashMap::default();
-    let mut first: HashMap<&[u8], u32, BuildHasherDefault<Fx>> = HashMap::with_capacity_and_hasher(if origin.is_some() { corners / 4 } else { corners }, Default::default());
+    let mut first: HashMap<&[u8], u32, BuildHasherDefault<Fx>> = HashMap::with_capacity_and_hasher(corners, Default::default());
     let mut order: Vec<u32> = Vec::new();
     let mut indices = Vec::with_capacity(corners);
     for c in 0..corners {
-        let k = key(c);
-        let local = origin.and_then(|o| {
-            let v = o[c];
-            let f = made_first[v as usize];
-            if f == u32::MAX {
-                return None;
-            }
-            std::iter::once(f).chain(made_more.get(&v).into_iter().flatten().copied()).find(|&m| key(order[m as usize] as usize) == k)
+        let next = order.len() as u32;
+        let v = *first.entry(&keys[c * stride..(c + 1) * stride]).or_insert_with(|| {
+            order.push(c as u32);
+            next
         });
-        let vertex = match local {
-            Some(m) => m,
-            None => {
-                let next = order.len() as u32;
-                let m = *first.entry(k).or_insert_with(|| {
-                    order.push(c as u32);
-                    next
-                });
-                if let Some(o) = origin {
-                    let v = o[c];
-                    if made_first[v as usize] == u32::MAX {
-                        made_first[v as usize] = m;
-                    } else {
-                        made_more.entry(v).or_default().push(m);
-                    }
-                }
-                m
-            }
-        };
-        indices.push(vertex);
+        indices.push(v);
     }
     let gather = |list: Vec<(String, Stream)>| list.into_iter().map(|(n, s)| (n, s.gather(&order))).collect::<Vec<_>>();
     Primitive {
@@ -100,6 +63,80 @@ pub fn weld_from(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, St
         targets: targets.into_iter().map(gather).collect(),
         indices,
         mode,
+    }
+}
+
+/// Re-indexes an indexed primitive to which per-corner streams are being added (tangents, flat
+/// normals). The result is exactly [`weld`] of the unwelded primitive plus those streams, without
+/// unwelding: a corner is compared with the vertices its own vertex already produced by its
+/// per-corner bytes alone, and only a corner unlike all of them is looked up by its full bytes.
+/// `extra` holds `(position, name, stream)`: where the stream goes among the attributes
+/// (`usize::MAX` appends).
+pub fn split_corners(base: &Primitive, extra: Vec<(usize, String, Stream)>) -> Primitive {
+    let corners = base.indices.len();
+    let extra_stride: usize = extra.iter().map(|(_, _, s)| s.format.elem_size()).sum();
+    let mut ekeys = Vec::with_capacity(corners * extra_stride);
+    for c in 0..corners {
+        for (_, _, s) in &extra {
+            ekeys.extend_from_slice(s.elem(c));
+        }
+    }
+    let ekey = |c: usize| &ekeys[c * extra_stride..(c + 1) * extra_stride];
+    let vertex_streams: Vec<&Stream> = base.attributes.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
+    let full_key = |c: usize| -> Box<[u8]> {
+        let v = base.indices[c] as usize;
+        let mut k = Vec::with_capacity(64);
+        for s in &vertex_streams {
+            k.extend_from_slice(s.elem(v));
+        }
+        k.extend_from_slice(ekey(c));
+        k.into_boxed_slice()
+    };
+    let n_vertices = base.vertex_count().max(base.indices.iter().map(|&v| v as usize + 1).max().unwrap_or(0));
+    let mut made_first = vec![u32::MAX; n_vertices];
+    let mut made_more: HashMap<u32, Vec<u32>, BuildHasherDefault<Fx>> = HashMap::default();
+    let mut global: HashMap<Box<[u8]>, u32, BuildHasherDefault<Fx>> = HashMap::with_capacity_and_hasher(n_vertices, Default::default());
+    let mut order: Vec<u32> = Vec::new();
+    let mut indices = Vec::with_capacity(corners);
+    for c in 0..corners {
+        let v = base.indices[c];
+        let first = made_first[v as usize];
+        let local = (first != u32::MAX)
+            .then(|| std::iter::once(first).chain(made_more.get(&v).into_iter().flatten().copied()).find(|&m| ekey(order[m as usize] as usize) == ekey(c)))
+            .flatten();
+        let m = match local {
+            Some(m) => m,
+            None => {
+                let next = order.len() as u32;
+                let m = *global.entry(full_key(c)).or_insert_with(|| {
+                    order.push(c as u32);
+                    next
+                });
+                if first == u32::MAX {
+                    made_first[v as usize] = m;
+                } else {
+                    made_more.entry(v).or_default().push(m);
+                }
+                m
+            }
+        };
+        indices.push(m);
+    }
+    let origins: Vec<u32> = order.iter().map(|&c| base.indices[c as usize]).collect();
+    let mut attributes: Vec<(String, Stream)> = base.attributes.iter().map(|(n, s)| (n.clone(), s.gather(&origins))).collect();
+    for (at, name, s) in extra {
+        let s = s.gather(&order);
+        if at < attributes.len() {
+            attributes.insert(at, (name, s));
+        } else {
+            attributes.push((name, s));
+        }
+    }
+    Primitive {
+        attributes,
+        targets: base.targets.iter().map(|t| t.iter().map(|(n, s)| (n.clone(), s.gather(&origins))).collect()).collect(),
+        indices,
+        mode: base.mode,
     }
 }
 
@@ -126,13 +163,14 @@ mod tests {
     }
 
     #[test]
-    fn origin_shortcut_gives_the_same_result() {
-        // Corner origins: 0,1,0,0,2 where origin 0's third corner differs, and origin 2 equals
-        // origin 1's bytes (so it merges across origins).
-        let uv = Stream::from_f32("VEC2", &[[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.5, 0.0], [1.0, 0.0]]);
-        let plain = weld(vec![("TEXCOORD_0".into(), uv.clone())], vec![], 4);
-        let fast = weld_from(vec![("TEXCOORD_0".into(), uv)], vec![], 4, Some(&[0, 1, 0, 0, 2]));
-        assert_eq!(plain, fast);
-        assert_eq!(fast.indices, vec![0, 1, 0, 2, 1]);
+    fn split_corners_splits_by_the_new_streams_and_merges_equal_vertices() {
+        // Vertices 1 and 2 are byte-identical; vertex 0's last corner gets another tangent.
+        let uv = Stream::from_f32("VEC2", &[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0]]);
+        let p = Primitive { attributes: vec![("TEXCOORD_0".into(), uv)], targets: vec![], indices: vec![0, 1, 2, 0], mode: 4 };
+        let t = Stream::from_f32("VEC4", &[[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, -1.0]]);
+        let out = split_corners(&p, vec![(usize::MAX, "TANGENT".into(), t)]);
+        assert_eq!(out.indices, vec![0, 1, 1, 2]);
+        assert_eq!(out.attr("TANGENT").unwrap().to_f32::<4>()[2], [-1.0, 0.0, 0.0, -1.0]);
+        assert_eq!(out.attributes.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["TEXCOORD_0", "TANGENT"]);
     }
 }

@@ -9,7 +9,7 @@ pub mod fallback;
 pub mod fast;
 pub mod mikk;
 
-use crate::scene::weld::{unweld, weld_from};
+use crate::scene::weld::split_corners;
 use crate::scene::{flat_normals, Primitive, Stream};
 use fallback::FallbackCounts;
 use glam::Vec3;
@@ -59,15 +59,18 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
     // Without POSITION (callers skip such primitives) the surface is a point.
     positions.resize(p.vertex_count(), [0.0; 3]);
     let uvs: Vec<[f32; 2]> = p.attr(&uv_name).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
-    let (mut corners, targets) = unweld(p);
-    corners.retain(|(n, _)| n != "TANGENT" && n != "_BITANGENT");
+    let mut base = p.clone();
+    base.mode = 4;
+    base.attributes.retain(|(n, _)| n != "TANGENT" && n != "_BITANGENT");
+    // Streams with one element per corner, and where each goes among the attributes.
+    let mut extra: Vec<(usize, String, Stream)> = Vec::new();
 
     // Corner-level normals: the vertex normals, or flat ones when the primitive has none.
     let generated_normals = p.attr("NORMAL").is_none();
     let (mesh_normals, corner_normals): (Vec<[f32; 3]>, Vec<[f32; 3]>) = if generated_normals {
         let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
         let (n, _) = flat_normals(&cp);
-        corners.insert(1.min(corners.len()), ("NORMAL".into(), Stream::from_f32("VEC3", &n)));
+        extra.push((1, "NORMAL".into(), Stream::from_f32("VEC3", &n)));
         (n.clone(), n)
     } else {
         let n: Vec<[f32; 3]> = p.attr("NORMAL").map(|s| s.to_f32()).unwrap_or_default();
@@ -89,16 +92,16 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
     let normals_v: Vec<Vec3> = corner_normals.iter().map(|&n| Vec3::from(n)).collect();
     let (tangents, fallback) = fallback::repair(&mut frames, &normals_v, &p.indices);
 
-    corners.push(("TANGENT".into(), Stream::from_f32("VEC4", &tangents)));
+    extra.push((usize::MAX, "TANGENT".into(), Stream::from_f32("VEC4", &tangents)));
     if opts.bitangents {
         let b: Vec<[f32; 3]> = tangents
             .iter()
             .zip(&normals_v)
             .map(|(t, n)| (n.normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3]).to_array())
             .collect();
-        corners.push(("_BITANGENT".into(), Stream::from_f32("VEC3", &b)));
+        extra.push((usize::MAX, "_BITANGENT".into(), Stream::from_f32("VEC3", &b)));
     }
-    let out = weld_from(corners, targets, 4, Some(&p.indices));
+    let out = split_corners(&base, extra);
     let stats = FrameStats {
         vertices_in: p.vertex_count(),
         vertices_out: out.vertex_count(),
