@@ -58,21 +58,12 @@ pub struct Args {
     /// Images inside the output (GLB, or .gltf's buffer) or as files beside a .gltf.
     #[arg(long, value_parser = ["embed", "external"], default_value = "embed")]
     pub images: String,
-    /// Let URIs reach outside the input's folder.
-    #[arg(long)]
-    pub allow_outside: bool,
-    /// Write a Make/Ninja depfile listing every input read (one input).
-    #[arg(long)]
-    pub depfile: Option<PathBuf>,
     #[command(flatten)]
     pub batch: super::report::BatchArgs,
 }
 
 pub fn run(a: Args) -> Result<u8> {
-    if a.depfile.is_some() && a.io.inputs.len() > 1 {
-        return Err(Error::usage("--depfile takes one input"));
-    }
-    let outputs = super::report::outputs(&a.io.inputs, &a.io.output, &a.batch.out_dir, &a.io.out_ext)?;
+    let outputs = a.io.outputs(&a.batch.out_dir)?;
     let strength = match (a.height_range, a.texel_size) {
         (Some(r), Some(t)) if t > 0.0 && r.is_finite() && t.is_finite() => r / t,
         (Some(_), Some(_)) => return Err(Error::usage("--texel-size must be a positive number")),
@@ -94,9 +85,9 @@ pub fn run(a: Args) -> Result<u8> {
         normal_convention: a.convention,
         keep_all: a.keep_all,
         bitangents: a.bitangents,
-        read: ReadOptions { allow_outside: a.allow_outside, ..Default::default() },
+        read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
         write: WriteOptions { images_external: a.images == "external", ..Default::default() },
-        depfile: a.depfile.clone(),
+        depfile: a.io.depfile.clone(),
     };
     let opts = a.batch.options();
     let results = batch::run(&a.io.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input))))?;

@@ -17,6 +17,22 @@ pub struct MeshIo {
     /// Extension of the outputs written into --out-dir.
     #[arg(long, value_parser = ["glb", "gltf"], default_value = "glb")]
     pub out_ext: String,
+    /// Let URIs reach outside the input's folder.
+    #[arg(long)]
+    pub allow_outside: bool,
+    /// Write a Make/Ninja depfile (one input) listing every file read.
+    #[arg(long)]
+    pub depfile: Option<PathBuf>,
+}
+
+impl MeshIo {
+    /// The output path of each input, after checking the options fit the number of inputs.
+    pub fn outputs(&self, out_dir: &Option<PathBuf>) -> Result<Vec<PathBuf>> {
+        if self.depfile.is_some() && self.inputs.len() > 1 {
+            return Err(Error::usage("--depfile takes one input"));
+        }
+        outputs(&self.inputs, &self.output, out_dir, &self.out_ext)
+    }
 }
 
 /// The options every command over many inputs shares.

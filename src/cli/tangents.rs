@@ -5,8 +5,8 @@ use bumpbake::scene::{NormalMode, ReadOptions, WriteOptions};
 use bumpbake::tangent::apply::ApplyOptions;
 use bumpbake::tangent::command::{run as run_job, TangentsJob, TangentsReport};
 use bumpbake::tangent::Options;
-use bumpbake::{Error, Result};
-use std::path::{Path, PathBuf};
+use bumpbake::Result;
+use std::path::Path;
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
@@ -31,12 +31,6 @@ pub struct Args {
     /// Normals for OBJ meshes without `vn`.
     #[arg(long, value_enum, default_value = "smooth")]
     pub normals: Normals,
-    /// Let URIs reach outside the input's folder.
-    #[arg(long)]
-    pub allow_outside: bool,
-    /// Write a Make/Ninja depfile (one input) listing every file read.
-    #[arg(long)]
-    pub depfile: Option<PathBuf>,
     #[command(flatten)]
     pub batch: super::report::BatchArgs,
 }
@@ -48,15 +42,12 @@ pub enum Normals {
 }
 
 pub fn run(a: Args) -> Result<u8> {
-    if a.depfile.is_some() && a.io.inputs.len() > 1 {
-        return Err(Error::usage("--depfile takes one input"));
-    }
-    let outputs = super::report::outputs(&a.io.inputs, &a.io.output, &a.batch.out_dir, &a.io.out_ext)?;
+    let outputs = a.io.outputs(&a.batch.out_dir)?;
     let job = |input: &Path, output: &Path| TangentsJob {
         input: input.to_path_buf(),
         output: output.to_path_buf(),
         read: ReadOptions {
-            allow_outside: a.allow_outside,
+            allow_outside: a.io.allow_outside,
             obj_normals: match a.normals {
                 Normals::Flat => NormalMode::Flat,
                 Normals::Smooth => NormalMode::Smooth,
@@ -64,7 +55,7 @@ pub fn run(a: Args) -> Result<u8> {
         },
         apply: ApplyOptions { all: a.all, overwrite: a.overwrite, frames: Options { bitangents: a.bitangents, ..Default::default() } },
         write: WriteOptions { embed: a.embed, ..Default::default() },
-        depfile: a.depfile.clone(),
+        depfile: a.io.depfile.clone(),
     };
     let opts = a.batch.options();
     let results = batch::run(&a.io.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input))))?;
