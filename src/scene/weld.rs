@@ -9,7 +9,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 /// FxHash (rustc's): the keys are attribute bytes we made ourselves, so a fast non-keyed hash is
 /// safe, and SipHash would cost more than the rest of the weld.
 #[derive(Default)]
-struct Fx(u64);
+pub(crate) struct Fx(u64);
 
 impl Hasher for Fx {
     fn write(&mut self, bytes: &[u8]) {

@@ -10,7 +10,8 @@
 //!
 //! Stages (each a module):
 //! 1. [`triangles`]: degenerate test, first-order tangents, the reference's triangle order;
-//! 2. [`weld`]: welded vertex ids, replaying the legacy weld's partitioning;
+//! 2. [`shortcut`] or [`weld`]: welded vertex ids, by hashing vertices when the representatives
+//!    provably do not matter, else by replaying the legacy weld's partitioning;
 //! 3. [`neighbors`]: triangle adjacency, including the legacy sort's unpaired tail;
 //! 4. [`groups`]: orientation-consistent fans around each welded vertex;
 //! 5. [`accumulate`]: sub-groups by the angular threshold and angle-weighted sums;
@@ -22,6 +23,7 @@ mod accumulate;
 mod groups;
 mod math;
 mod neighbors;
+mod shortcut;
 mod triangles;
 mod weld;
 
@@ -90,9 +92,12 @@ pub fn generate_timed(
     }
     let mut tri = timings.time("triangles", || triangles::Triangles::build(&c));
     let ng = tri.n_good;
-    let welded = timings.time("weld", || weld::weld(&c, &tri.order));
+    let (welded, short_tail) = timings.time("weld", || match shortcut::weld(&c, &tri.order, ng) {
+        Some(w) => (w, true),
+        None => (weld::weld(&c, &tri.order), false),
+    });
     let w = &welded[..3 * ng];
-    let nb = timings.time("neighbors", || neighbors::build(w, 3 * n_faces));
+    let nb = timings.time("neighbors", || neighbors::build(w, 3 * n_faces, short_tail));
     let mut grp = timings.time("groups", || groups::build(w, &nb, &mut tri));
     drop(nb);
     let vals = timings.time("accumulate", || accumulate_all(&c, w, &tri, &mut grp));

@@ -26,15 +26,16 @@ fn edge_ends(w: &[u32], e: usize) -> (u32, u32) {
 
 /// `nb[3 t + n]`: the internal index of the triangle across edge `n` (corners `n`, `n + 1`) of
 /// good triangle `t`, or [`NONE`]. `w` holds the welded ids of the good triangles' corners;
-/// `id_space` bounds them.
-pub(crate) fn build(w: &[u32], id_space: usize) -> Vec<u32> {
+/// `id_space` bounds them. `short_tail`: fewer than 3 edges are known to share the largest `i0`
+/// (see [`super::shortcut`]), so no replay is needed whatever the ids.
+pub(crate) fn build(w: &[u32], id_space: usize, short_tail: bool) -> Vec<u32> {
     let n_edges = w.len();
     let mut nb = vec![NONE; n_edges];
     if n_edges == 0 {
         return nb;
     }
-    let max_i0 = (0..n_edges).into_par_iter().with_min_len(1 << 14).map(|e| i0_of(w, e)).max().unwrap_or(0);
-    let tail_len = (0..n_edges).into_par_iter().with_min_len(1 << 14).filter(|&e| i0_of(w, e) == max_i0).count();
+    let max_i0 = if short_tail { 0 } else { (0..n_edges).into_par_iter().with_min_len(1 << 14).map(|e| i0_of(w, e)).max().unwrap_or(0) };
+    let tail_len = if short_tail { 0 } else { (0..n_edges).into_par_iter().with_min_len(1 << 14).filter(|&e| i0_of(w, e) == max_i0).count() };
     // Pair every i0 bucket except the quirky last one (when it needs the replay).
     let replay = tail_len >= 3;
     // Edges go to ranges of i0 (chunk by chunk, keeping triangle order), then each range is

@@ -80,37 +80,93 @@ fn longest_axis(d: V3) -> usize {
     }
 }
 
+/// The first split of the legacy weld: the bounding box of all corners, its longest axis, and
+/// which of the [`GROUPS`] buckets along it each position falls in.
+struct Buckets {
+    mn: V3,
+    d: V3,
+    cm: usize,
+}
+
+impl Buckets {
+    /// `None` for an empty list.
+    fn new(pos: &[V3]) -> Option<Buckets> {
+        // Bounding box in fixed chunks (same value as the reference's sequential fold; the
+        // chunking does not depend on the thread count).
+        let bbox = pos
+            .par_chunks(CHUNK)
+            .map(|ch| {
+                let mut b = EMPTY;
+                ch.iter().for_each(|&p| b.grow(p));
+                b
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold(EMPTY, BBox::union);
+        if pos.is_empty() {
+            return None;
+        }
+        let (mn, mx) = bbox.bounds();
+        let d = [mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]];
+        Some(Buckets { mn, d, cm: longest_axis(d) })
+    }
+    #[inline]
+    fn of(&self, p: &V3) -> usize {
+        let cm = self.cm;
+        let t = (p[cm] - self.mn[cm]) / self.d[cm];
+        let g = (GROUPS as f32 * t.clamp(0.0, 1.0)) as u16;
+        g.min(GROUPS as u16 - 1) as usize
+    }
+}
+
+/// Positions in list order, gathered once.
+fn list_positions(c: &Corners, order: &[u32]) -> Vec<V3> {
+    (0..order.len() * 3).into_par_iter().with_min_len(1 << 12).map(|k| c.pos(3 * order[k / 3] as usize + k % 3)).collect()
+}
+
+/// The welded id [`weld`] gives list entries `ks`, replaying only the buckets they fall in.
+pub(crate) fn welded_of(c: &Corners, order: &[u32], ks: &[usize]) -> Vec<u32> {
+    let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
+    let pos = list_positions(c, order);
+    let Some(bk) = Buckets::new(&pos) else { return Vec::new() };
+    let mut wanted: Vec<usize> = ks.iter().map(|&k| bk.of(&pos[k])).collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let mut answer: HashMap<usize, u32> = ks.iter().map(|&k| (k, id_of(k))).collect();
+    let mut bufs: Vec<Vec<Tmp>> = vec![Vec::new(); GROUPS];
+    for g in wanted {
+        bufs[g].push(Tmp { p: [0.0; 3], k: 0 }); // marks the bucket as wanted
+    }
+    for (k, p) in pos.iter().enumerate() {
+        let b = &mut bufs[bk.of(p)];
+        if !b.is_empty() {
+            b.push(Tmp { p: *p, k: k as u32 });
+        }
+    }
+    for mut buf in bufs.into_iter().filter(|b| !b.is_empty()) {
+        buf.remove(0);
+        let mut reps = vec![SELF; buf.len()];
+        merge(c, order, &mut buf, &mut reps);
+        for (t, &r) in buf.iter().zip(&reps) {
+            if let Some(a) = answer.get_mut(&(t.k as usize)) {
+                if r != SELF {
+                    *a = r;
+                }
+            }
+        }
+    }
+    ks.iter().map(|k| answer[k]).collect()
+}
+
 /// Returns, for each list entry `k` (3 per internal triangle, good triangles first), the input
 /// corner id of its welded representative.
 pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
     let n = order.len() * 3;
     let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
-    // Positions in list order, gathered once.
-    let pos: Vec<V3> = (0..n).into_par_iter().with_min_len(1 << 12).map(|k| c.pos(id_of(k) as usize)).collect();
-    // Bounding box in fixed chunks (same value as the reference's sequential fold; the chunking
-    // does not depend on the thread count).
-    let bbox = pos
-        .par_chunks(CHUNK)
-        .map(|ch| {
-            let mut b = EMPTY;
-            ch.iter().for_each(|&p| b.grow(p));
-            b
-        })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .fold(EMPTY, BBox::union);
+    let pos = list_positions(c, order);
     let mut welded: Vec<u32> = (0..n).into_par_iter().with_min_len(1 << 12).map(id_of).collect();
-    if n == 0 {
-        return welded;
-    }
-    let (mn, mx) = bbox.bounds();
-    let d = [mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]];
-    let cm = longest_axis(d);
-    let bucket_of = |p: &V3| {
-        let t = (p[cm] - mn[cm]) / d[cm];
-        let g = (GROUPS as f32 * t.clamp(0.0, 1.0)) as u16;
-        g.min(GROUPS as u16 - 1) as usize
-    };
+    let Some(bk) = Buckets::new(&pos) else { return welded };
+    let bucket_of = |p: &V3| bk.of(p);
     // Stable counting sort by bucket (the reference's `sort_by_key`), in parallel: each chunk of
     // the list sorts itself by bucket, then each bucket concatenates its segments chunk by chunk.
     let chunks: Vec<(Vec<Tmp>, Vec<u32>)> = pos
