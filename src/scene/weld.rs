@@ -66,70 +66,158 @@ pub fn weld(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)
     }
 }
 
-/// Re-indexes an indexed primitive to which per-corner streams are being added (tangents, flat
-/// normals). The result is exactly [`weld`] of the unwelded primitive plus those streams, without
-/// unwelding: a corner is compared with the vertices its own vertex already produced by its
-/// per-corner bytes alone, and only a corner unlike all of them is looked up by its full bytes.
-/// `extra` holds `(position, name, stream)`: where the stream goes among the attributes
-/// (`usize::MAX` appends).
-pub fn split_corners(base: &Primitive, extra: Vec<(usize, String, Stream)>) -> Primitive {
-    let corners = base.indices.len();
-    let extra_stride: usize = extra.iter().map(|(_, _, s)| s.format.elem_size()).sum();
-    let mut ekeys = Vec::with_capacity(corners * extra_stride);
-    for c in 0..corners {
-        for (_, _, s) in &extra {
-            ekeys.extend_from_slice(s.elem(c));
+/// For each item, the first item (lowest index) equal to it. `hashes[i]` is item `i`'s hash, or 0
+/// for an item to leave alone (it maps to itself); `eq` decides equality of items with equal
+/// hashes. Items are split into shards by hash (equal items share one), each resolved with its
+/// own open-addressing table in parallel: the answer does not depend on the thread count.
+pub(crate) fn first_equal(hashes: &[u64], eq: impl Fn(usize, usize) -> bool + Sync) -> Vec<u32> {
+    use rayon::prelude::*;
+    const SHARD_BITS: u32 = 4;
+    let mut shards: Vec<Vec<u32>> = vec![Vec::new(); 1 << SHARD_BITS];
+    for (i, &h) in hashes.iter().enumerate() {
+        if h != 0 {
+            shards[(h >> (64 - SHARD_BITS)) as usize].push(i as u32);
         }
     }
-    let ekey = |c: usize| &ekeys[c * extra_stride..(c + 1) * extra_stride];
-    let vertex_streams: Vec<&Stream> = base.attributes.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
-    let full_key = |c: usize| -> Box<[u8]> {
-        let v = base.indices[c] as usize;
-        let mut k = Vec::with_capacity(64);
-        for s in &vertex_streams {
-            k.extend_from_slice(s.elem(v));
-        }
-        k.extend_from_slice(ekey(c));
-        k.into_boxed_slice()
-    };
+    let found: Vec<Vec<(u32, u32)>> = shards
+        .par_iter()
+        .map(|items| {
+            let mask = (2 * items.len()).next_power_of_two().max(16) - 1;
+            let mut slots: Vec<(u32, u32)> = vec![(u32::MAX, 0); mask + 1];
+            let mut out = Vec::new();
+            for &i in items {
+                let h = hashes[i as usize];
+                let tag = (h >> 32) as u32;
+                let mut at = h as usize & mask;
+                loop {
+                    let (s, t) = slots[at];
+                    if s == u32::MAX {
+                        slots[at] = (i, tag);
+                        break;
+                    }
+                    if t == tag && eq(s as usize, i as usize) {
+                        out.push((i, s));
+                        break;
+                    }
+                    at = (at + 1) & mask;
+                }
+            }
+            out
+        })
+        .collect();
+    let mut first: Vec<u32> = (0..hashes.len() as u32).collect();
+    for (i, f) in found.into_iter().flatten() {
+        first[i as usize] = f;
+    }
+    first
+}
+
+/// FxHash of 32-bit words, never 0 (0 marks an item [`first_equal`] leaves alone).
+pub(crate) fn hash_words(words: impl IntoIterator<Item = u32>) -> u64 {
+    let mut h = Fx::default();
+    for w in words {
+        h.add(w as u64);
+    }
+    h.0 | 1
+}
+
+/// A stream with one `f32` vector per corner, to be added to a primitive by [`split_corners`].
+#[derive(Debug, Clone, Copy)]
+pub struct CornerStream<'a> {
+    /// Where the stream goes among the attributes (`usize::MAX` appends).
+    pub at: usize,
+    pub name: &'a str,
+    /// `VEC2`, `VEC3` or `VEC4`.
+    pub ty: &'a str,
+    /// The components, corner after corner.
+    pub values: &'a [f32],
+}
+
+impl CornerStream<'_> {
+    fn width(&self) -> usize {
+        super::accessor::component_count(self.ty).unwrap_or(1)
+    }
+    fn get(&self, c: usize) -> &[f32] {
+        let n = self.width();
+        &self.values[c * n..(c + 1) * n]
+    }
+}
+
+/// Re-indexes an indexed primitive to which per-corner streams are being added (tangents, flat
+/// normals). The result is exactly [`weld`] of the unwelded primitive plus those streams, without
+/// unwelding, leaving out the attributes named in `leave_out`: byte-identical vertices are found once (by hashing vertices, not corners), and a
+/// corner then only compares its new values (bit for bit) with the vertices already made from its
+/// vertex's class.
+pub fn split_corners(base: &Primitive, leave_out: &[&str], extra: &[CornerStream]) -> Primitive {
+    use rayon::prelude::*;
+    let corners = base.indices.len();
+    let kept: Vec<&(String, Stream)> = base.attributes.iter().filter(|(n, _)| !leave_out.contains(&n.as_str())).collect();
+    let vertex_streams: Vec<&Stream> = kept.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
     let n_vertices = base.vertex_count().max(base.indices.iter().map(|&v| v as usize + 1).max().unwrap_or(0));
+    let mut used = vec![false; n_vertices];
+    for &v in &base.indices {
+        used[v as usize] = true;
+    }
+    let hashes: Vec<u64> = (0..n_vertices)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .map(|v| {
+            if !used[v] {
+                return 0;
+            }
+            let mut h = Fx::default();
+            for s in &vertex_streams {
+                h.write(s.elem(v));
+            }
+            h.0 | 1
+        })
+        .collect();
+    drop(used);
+    // The class of each vertex: the first byte-identical vertex.
+    let class = first_equal(&hashes, |a, b| vertex_streams.iter().all(|s| s.elem(a) == s.elem(b)));
+    drop(hashes);
+    let same = |a: usize, b: usize| extra.iter().all(|s| s.get(a).iter().zip(s.get(b)).all(|(x, y)| x.to_bits() == y.to_bits()));
     let mut made_first = vec![u32::MAX; n_vertices];
     let mut made_more: HashMap<u32, Vec<u32>, BuildHasherDefault<Fx>> = HashMap::default();
-    let mut global: HashMap<Box<[u8]>, u32, BuildHasherDefault<Fx>> = HashMap::with_capacity_and_hasher(n_vertices, Default::default());
     let mut order: Vec<u32> = Vec::new();
     let mut indices = Vec::with_capacity(corners);
     for c in 0..corners {
-        let v = base.indices[c];
+        let v = class[base.indices[c] as usize];
         let first = made_first[v as usize];
-        let local = (first != u32::MAX)
-            .then(|| std::iter::once(first).chain(made_more.get(&v).into_iter().flatten().copied()).find(|&m| ekey(order[m as usize] as usize) == ekey(c)))
-            .flatten();
-        let m = match local {
-            Some(m) => m,
-            None => {
-                let next = order.len() as u32;
-                let m = *global.entry(full_key(c)).or_insert_with(|| {
+        let m = if first == u32::MAX {
+            made_first[v as usize] = order.len() as u32;
+            order.push(c as u32);
+            order.len() as u32 - 1
+        } else if same(order[first as usize] as usize, c) {
+            first
+        } else {
+            let more = made_more.entry(v).or_default();
+            match more.iter().copied().find(|&m| same(order[m as usize] as usize, c)) {
+                Some(m) => m,
+                None => {
+                    more.push(order.len() as u32);
                     order.push(c as u32);
-                    next
-                });
-                if first == u32::MAX {
-                    made_first[v as usize] = m;
-                } else {
-                    made_more.entry(v).or_default().push(m);
+                    order.len() as u32 - 1
                 }
-                m
             }
         };
         indices.push(m);
     }
+    drop((made_first, made_more, class));
     let origins: Vec<u32> = order.iter().map(|&c| base.indices[c as usize]).collect();
-    let mut attributes: Vec<(String, Stream)> = base.attributes.iter().map(|(n, s)| (n.clone(), s.gather(&origins))).collect();
-    for (at, name, s) in extra {
-        let s = s.gather(&order);
-        if at < attributes.len() {
-            attributes.insert(at, (name, s));
+    let mut attributes: Vec<(String, Stream)> = kept.iter().map(|(n, s)| (n.clone(), s.gather(&origins))).collect();
+    for s in extra {
+        let mut data = Vec::with_capacity(order.len() * s.width() * 4);
+        for &c in &order {
+            for x in s.get(c as usize) {
+                data.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        let stream = Stream { format: super::accessor::Format::f32(s.ty), data, template: None };
+        if s.at < attributes.len() {
+            attributes.insert(s.at, (s.name.to_string(), stream));
         } else {
-            attributes.push((name, s));
+            attributes.push((s.name.to_string(), stream));
         }
     }
     Primitive {
@@ -167,8 +255,8 @@ mod tests {
         // Vertices 1 and 2 are byte-identical; vertex 0's last corner gets another tangent.
         let uv = Stream::from_f32("VEC2", &[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0]]);
         let p = Primitive { attributes: vec![("TEXCOORD_0".into(), uv)], targets: vec![], indices: vec![0, 1, 2, 0], mode: 4 };
-        let t = Stream::from_f32("VEC4", &[[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, -1.0]]);
-        let out = split_corners(&p, vec![(usize::MAX, "TANGENT".into(), t)]);
+        let t = [[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, -1.0f32]];
+        let out = split_corners(&p, &[], &[CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: t.as_flattened() }]);
         assert_eq!(out.indices, vec![0, 1, 1, 2]);
         assert_eq!(out.attr("TANGENT").unwrap().to_f32::<4>()[2], [-1.0, 0.0, 0.0, -1.0]);
         assert_eq!(out.attributes.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["TEXCOORD_0", "TANGENT"]);

@@ -65,8 +65,13 @@ impl FallbackCounts {
 
 /// True when `t` is a frame the conventions accept for normal `n`.
 pub fn is_valid(t: [f32; 4], n: Vec3) -> bool {
+    is_valid_unit(t, unit(n))
+}
+
+/// [`is_valid`] given the normal's [`unit`] vector.
+fn is_valid_unit(t: [f32; 4], n: Option<Vec3>) -> bool {
     let v = Vec3::new(t[0], t[1], t[2]);
-    let Some(n) = unit(n) else { return false };
+    let Some(n) = n else { return false };
     v.is_finite() && (v.length() - 1.0).abs() <= UNIT_TOLERANCE && (t[3] == 1.0 || t[3] == -1.0) && v.dot(n).abs() <= ORTHO_TOLERANCE
 }
 
@@ -95,65 +100,92 @@ pub fn any_orthogonal(n: Vec3) -> Vec3 {
     orthogonalise(axis, n).unwrap_or(Vec3::X)
 }
 
-/// Replaces every unusable corner frame. `frames` and `normals` are per corner (three per
-/// triangle); `vertex` gives each corner's vertex, so that corners of one vertex can lend to
-/// each other. Frames already carry the output's `w` convention.
-pub fn repair(frames: &mut [Option<[f32; 4]>], normals: &[Vec3], vertex: &[u32]) -> (Vec<[f32; 4]>, FallbackCounts) {
+/// Where [`repair`] finds each corner's normal and vertex.
+#[derive(Debug, Clone, Copy)]
+pub struct CornerNormals<'a> {
+    pub normals: &'a [[f32; 3]],
+    /// Corner -> index into `normals`.
+    pub normal_of: &'a [u32],
+    /// Corner -> vertex: corners of one vertex lend to each other.
+    pub vertex: &'a [u32],
+}
+
+/// Replaces every unusable corner frame, in place. `frames` are per corner (three per triangle),
+/// `w == 0` where the reference gave no frame, otherwise already in the output's `w` convention.
+pub fn repair(frames: &mut [[f32; 4]], at: CornerNormals) -> FallbackCounts {
+    use rayon::prelude::*;
     let mut counts = FallbackCounts::default();
-    let ok: Vec<bool> = frames.iter().zip(normals).map(|(f, &n)| f.map(|t| is_valid(t, n)).unwrap_or(false)).collect();
+    // Unit normals, once per normal rather than once per corner.
+    let units: Vec<Option<Vec3>> = at.normals.par_iter().with_min_len(1 << 12).map(|&n| unit(Vec3::from(n))).collect();
+    let ok = |frames: &[[f32; 4]], c: usize| is_valid_unit(frames[c], units[at.normal_of[c] as usize]);
+    let bad: Vec<usize> = (0..frames.len()).into_par_iter().with_min_len(1 << 12).filter(|&c| !ok(frames, c)).collect();
+    if bad.is_empty() {
+        return counts;
+    }
     // First valid corner of each vertex, to lend from across triangles.
-    let n_vertices = vertex.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
+    let n_vertices = at.vertex.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
     let mut by_vertex = vec![usize::MAX; n_vertices];
-    for (c, &good) in ok.iter().enumerate() {
-        if good && by_vertex[vertex[c] as usize] == usize::MAX {
-            by_vertex[vertex[c] as usize] = c;
+    for c in 0..frames.len() {
+        let v = at.vertex[c] as usize;
+        if by_vertex[v] == usize::MAX && ok(frames, c) {
+            by_vertex[v] = c;
         }
     }
-    let mut out = Vec::with_capacity(frames.len());
-    for c in 0..frames.len() {
-        if ok[c] {
-            out.push(frames[c].expect("valid frames exist"));
-            continue;
+    // Only valid corners lend and only invalid ones change, so the order of repairs is free.
+    let mut bad_flag = vec![false; frames.len()];
+    bad.iter().for_each(|&c| bad_flag[c] = true);
+    for &c in &bad {
+        let original = frames[c];
+        let defined = original[3] != 0.0;
+        if defined {
+            counts.invalid += 1;
+        } else {
+            counts.undefined += 1;
         }
-        match frames[c] {
-            None => counts.undefined += 1,
-            Some(_) => counts.invalid += 1,
-        }
-        let n = normals[c];
+        let n = Vec3::from(at.normals[at.normal_of[c] as usize]);
         let tri = c / 3 * 3;
-        let lenders = (tri..tri + 3).filter(|&k| k != c && ok[k]).chain(Some(by_vertex[vertex[c] as usize]).filter(|&k| k != usize::MAX));
+        let lenders = (tri..tri + 3).filter(|&k| k != c && !bad_flag[k]).chain(Some(by_vertex[at.vertex[c] as usize]).filter(|&k| k != usize::MAX));
         let mut chosen = None;
         for k in lenders {
-            let t = frames[k].expect("valid frames exist");
+            let t = frames[k];
             if let Some(v) = orthogonalise(Vec3::new(t[0], t[1], t[2]), n) {
                 chosen = Some([v.x, v.y, v.z, t[3]]);
                 break;
             }
         }
-        match chosen {
+        frames[c] = match chosen {
             Some(f) => {
                 counts.borrowed += 1;
-                out.push(f);
+                f
             }
             None => {
-                let w = frames[c].map(|t| if t[3] < 0.0 { -1.0 } else { 1.0 }).unwrap_or(1.0);
+                let w = if defined && original[3] < 0.0 { -1.0 } else { 1.0 };
                 let v = any_orthogonal(n);
-                out.push([v.x, v.y, v.z, w]);
+                [v.x, v.y, v.z, w]
             }
-        }
+        };
     }
-    (out, counts)
+    counts
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// `repair` on frames with `None` as `w = 0`, one normal per corner.
+    fn fix(f: &[Option<[f32; 4]>], normals: &[Vec3], vertex: &[u32]) -> (Vec<[f32; 4]>, FallbackCounts) {
+        let mut frames: Vec<[f32; 4]> = f.iter().map(|t| t.unwrap_or([0.0; 4])).collect();
+        let n: Vec<[f32; 3]> = normals.iter().map(|v| v.to_array()).collect();
+        let ids: Vec<u32> = (0..n.len() as u32).collect();
+        let c = repair(&mut frames, CornerNormals { normals: &n, normal_of: &ids, vertex });
+        (frames, c)
+    }
+
     #[test]
     fn undefined_corner_borrows_from_its_triangle() {
         let n = Vec3::Z;
-        let mut f = vec![Some([1.0, 0.0, 0.0, -1.0]), None, Some([0.0, 0.0, 1.0, 1.0])];
-        let (out, c) = repair(&mut f, &[n, n, n], &[0, 1, 2]);
+        let f = vec![Some([1.0, 0.0, 0.0, -1.0]), None, Some([0.0, 0.0, 1.0, 1.0])];
+        let (out, c) = fix(&f, &[n, n, n], &[0, 1, 2]);
         assert_eq!(out[1], [1.0, 0.0, 0.0, -1.0]);
         // Parallel to the normal: invalid, borrows the first corner's tangent.
         assert_eq!(out[2], [1.0, 0.0, 0.0, -1.0]);
@@ -163,8 +195,8 @@ mod tests {
     #[test]
     fn lone_corner_gets_an_axis_orthogonal_to_its_normal() {
         let n = Vec3::new(1.0, 1.0, 0.0).normalize();
-        let mut f = vec![None, None, None];
-        let (out, c) = repair(&mut f, &[n, n, n], &[0, 1, 2]);
+        let f = vec![None, None, None];
+        let (out, c) = fix(&f, &[n, n, n], &[0, 1, 2]);
         for t in out {
             assert!(is_valid(t, n), "{t:?}");
         }
@@ -197,7 +229,7 @@ mod tests {
         let n = Vec3::Z;
         // Triangle 0: one valid corner (w = -1), one undefined, one non-unit.
         // Triangle 1: every corner invalid (NaN, w = -1) and no valid corner at its vertices.
-        let mut f = vec![
+        let f = vec![
             Some([0.0, 1.0, 0.0, -1.0]),
             None,
             Some([2.0, 0.0, 0.0, 1.0]),
@@ -205,7 +237,7 @@ mod tests {
             Some([f32::NAN, 0.0, 0.0, -1.0]),
             None,
         ];
-        let (out, c) = repair(&mut f, &[n; 6], &[0, 1, 2, 3, 4, 5]);
+        let (out, c) = fix(&f, &[n; 6], &[0, 1, 2, 3, 4, 5]);
         assert_eq!(c, FallbackCounts { undefined: 2, invalid: 3, borrowed: 2 });
         assert_eq!(out[1], [0.0, 1.0, 0.0, -1.0]);
         assert_eq!(out[2], [0.0, 1.0, 0.0, -1.0]);
@@ -219,9 +251,9 @@ mod tests {
     #[test]
     fn lender_across_triangles_at_the_same_vertex() {
         let n = Vec3::Y;
-        let mut f = vec![Some([1.0, 0.0, 0.0, 1.0]), None, None, None, None, None];
+        let f = vec![Some([1.0, 0.0, 0.0, 1.0]), None, None, None, None, None];
         // Corner 4 is vertex 0 again: it borrows corner 0's frame through the vertex.
-        let (out, c) = repair(&mut f, &[n; 6], &[0, 1, 2, 3, 0, 5]);
+        let (out, c) = fix(&f, &[n; 6], &[0, 1, 2, 3, 0, 5]);
         assert_eq!(out[4], [1.0, 0.0, 0.0, 1.0]);
         assert_eq!(c.undefined, 5);
         assert_eq!(c.borrowed, 3);

@@ -17,14 +17,21 @@ pub enum Engine {
 /// (`sign = +1` when the UV orientation is preserved), or `None` where the reference gives no
 /// answer (a degenerate triangle with no neighbour to borrow from).
 pub fn generate(mesh: &TriMesh, engine: Engine) -> Vec<Option<[f32; 4]>> {
+    frames(mesh, engine).into_iter().map(|t| (t[3] != 0.0).then_some(t)).collect()
+}
+
+/// [`generate`] as flat frames, `[0.0; 4]` (`w == 0`) where it gives `None`: a fifth less memory,
+/// and no conversion for the fast engine.
+pub fn frames(mesh: &TriMesh, engine: Engine) -> Vec<[f32; 4]> {
+    let bevy = |mesh: &TriMesh| generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect();
     match engine {
-        Engine::Bevy => generate_bevy(mesh),
+        Engine::Bevy => bevy(mesh),
         Engine::Fast => match super::fast::generate(mesh) {
             Ok(out) => out,
             // Beyond 32-bit corner ids: the reference has no such limit.
-            Err(super::fast::Unsupported::TooLarge) => generate_bevy(mesh),
+            Err(super::fast::Unsupported::TooLarge) => bevy(mesh),
             // An index past an attribute array: no frame is defined (the reference panics).
-            Err(super::fast::Unsupported::IndexOutOfRange) => vec![None; mesh.indices.len()],
+            Err(super::fast::Unsupported::IndexOutOfRange) => vec![[0.0; 4]; mesh.indices.len()],
         },
     }
 }

@@ -9,8 +9,9 @@ pub mod fallback;
 pub mod fast;
 pub mod mikk;
 
-use crate::scene::weld::split_corners;
-use crate::scene::{flat_normals, Primitive, Stream};
+use crate::scene::weld::{split_corners, CornerStream};
+use crate::scene::{flat_normals, Primitive};
+use rayon::prelude::*;
 use fallback::FallbackCounts;
 use glam::Vec3;
 
@@ -59,49 +60,50 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
     // Without POSITION (callers skip such primitives) the surface is a point.
     positions.resize(p.vertex_count(), [0.0; 3]);
     let uvs: Vec<[f32; 2]> = p.attr(&uv_name).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
-    let mut base = p.clone();
-    base.mode = 4;
-    base.attributes.retain(|(n, _)| n != "TANGENT" && n != "_BITANGENT");
-    // Streams with one element per corner, and where each goes among the attributes.
-    let mut extra: Vec<(usize, String, Stream)> = Vec::new();
 
-    // Corner-level normals: the vertex normals, or flat ones when the primitive has none.
+    // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
+    // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
     let generated_normals = p.attr("NORMAL").is_none();
-    let (mesh_normals, corner_normals): (Vec<[f32; 3]>, Vec<[f32; 3]>) = if generated_normals {
+    let corner_ids: Vec<u32>;
+    let (normals, normal_of, mut frames) = if generated_normals {
         let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
         let (n, _) = flat_normals(&cp);
-        extra.push((1, "NORMAL".into(), Stream::from_f32("VEC3", &n)));
-        (n.clone(), n)
+        let cu: Vec<[f32; 2]> = p.indices.iter().map(|&i| uvs[i as usize]).collect();
+        corner_ids = (0..p.indices.len() as u32).collect();
+        let frames = generate_with_stack(&TriMesh { positions: &cp, normals: &n, uvs: &cu, indices: &corner_ids }, opts.engine);
+        (n, corner_ids.as_slice(), frames)
     } else {
         let n: Vec<[f32; 3]> = p.attr("NORMAL").map(|s| s.to_f32()).unwrap_or_default();
-        let cn = p.indices.iter().map(|&i| n[i as usize]).collect();
-        (n, cn)
+        let frames = generate_with_stack(&TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices }, opts.engine);
+        (n, p.indices.as_slice(), frames)
     };
-
-    // MikkTSpace only sees values per corner, so unwelded (flat-normal) input is equivalent.
-    let frames = if generated_normals {
-        let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
-        let cu: Vec<[f32; 2]> = p.indices.iter().map(|&i| uvs[i as usize]).collect();
-        let idx: Vec<u32> = (0..p.indices.len() as u32).collect();
-        generate_with_stack(&TriMesh { positions: &cp, normals: &mesh_normals, uvs: &cu, indices: &idx }, opts.engine)
-    } else {
-        generate_with_stack(&TriMesh { positions: &positions, normals: &mesh_normals, uvs: &uvs, indices: &p.indices }, opts.engine)
-    };
-    let flip = if uv_v_up { 1.0 } else { -1.0 };
-    let mut frames: Vec<Option<[f32; 4]>> = frames.into_iter().map(|f| f.map(|t| [t[0], t[1], t[2], t[3] * flip])).collect();
-    let normals_v: Vec<Vec3> = corner_normals.iter().map(|&n| Vec3::from(n)).collect();
-    let (tangents, fallback) = fallback::repair(&mut frames, &normals_v, &p.indices);
-
-    extra.push((usize::MAX, "TANGENT".into(), Stream::from_f32("VEC4", &tangents)));
-    if opts.bitangents {
-        let b: Vec<[f32; 3]> = tangents
-            .iter()
-            .zip(&normals_v)
-            .map(|(t, n)| (n.normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3]).to_array())
-            .collect();
-        extra.push((usize::MAX, "_BITANGENT".into(), Stream::from_f32("VEC3", &b)));
+    drop((positions, uvs));
+    if !uv_v_up {
+        // glTF UVs run v down: the output's w is the reference's sign negated (see the conventions).
+        frames.par_iter_mut().with_min_len(1 << 12).for_each(|t| t[3] = -t[3]);
     }
-    let out = split_corners(&base, extra);
+    let fallback = fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
+
+    let bitangents: Vec<[f32; 3]> = if opts.bitangents {
+        frames
+            .par_iter()
+            .zip(normal_of.par_iter())
+            .map(|(t, &n)| (Vec3::from(normals[n as usize]).normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3]).to_array())
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let flat_normals: Vec<[f32; 3]> = if generated_normals { normals } else { Vec::new() };
+    let mut extra = Vec::new();
+    if generated_normals {
+        extra.push(CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: flat_normals.as_flattened() });
+    }
+    extra.push(CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: frames.as_flattened() });
+    if opts.bitangents {
+        extra.push(CornerStream { at: usize::MAX, name: "_BITANGENT", ty: "VEC3", values: bitangents.as_flattened() });
+    }
+    let mut out = split_corners(p, &["TANGENT", "_BITANGENT"], &extra);
+    out.mode = 4;
     let stats = FrameStats {
         vertices_in: p.vertex_count(),
         vertices_out: out.vertex_count(),
@@ -120,9 +122,9 @@ const STACK_PER_TRIANGLE: usize = 1024;
 /// worker stack and abort the process. When the mesh has a vertex position shared by more than
 /// a thousand corners, generation runs on a thread whose stack grows with that count.
 /// Only the `bevy_mikktspace` engine recurses; ours walks groups with an explicit stack.
-fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> Vec<Option<[f32; 4]>> {
+fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> Vec<[f32; 4]> {
     if engine != mikk::Engine::Bevy {
-        return mikk::generate(mesh, engine);
+        return mikk::frames(mesh, engine);
     }
     let mut per_position: std::collections::HashMap<[u32; 3], usize> = std::collections::HashMap::new();
     let mut most = 0;
@@ -133,14 +135,14 @@ fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> Vec<Option<[f32;
         most = most.max(*n);
     }
     if most <= 1000 {
-        return mikk::generate(mesh, engine);
+        return mikk::frames(mesh, engine);
     }
     let stack = (4 << 20) + most * STACK_PER_TRIANGLE;
     std::thread::scope(|s| {
-        match std::thread::Builder::new().name("mikktspace".into()).stack_size(stack).spawn_scoped(s, || mikk::generate(mesh, engine)) {
+        match std::thread::Builder::new().name("mikktspace".into()).stack_size(stack).spawn_scoped(s, || mikk::frames(mesh, engine)) {
             Ok(h) => h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)),
             // No thread to be had: try on this one.
-            Err(_) => mikk::generate(mesh, engine),
+            Err(_) => mikk::frames(mesh, engine),
         }
     })
 }

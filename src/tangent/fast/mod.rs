@@ -65,10 +65,10 @@ pub enum Unsupported {
     TooLarge,
 }
 
-/// Per-corner frames `(t.x, t.y, t.z, sign)`, identical to the reference's; `None` where the
-/// reference gives no answer. The vector has one entry per index (a trailing partial triangle
-/// gets `None`, as with the reference wrapper).
-pub fn generate(mesh: &TriMesh) -> Result<Vec<Option<[f32; 4]>>, Unsupported> {
+/// Per-corner frames `(t.x, t.y, t.z, sign)`, identical to the reference's; all zero (`w == 0`)
+/// where the reference gives no answer. The vector has one entry per index (a trailing partial
+/// triangle gets none, as with the reference wrapper).
+pub fn generate(mesh: &TriMesh) -> Result<Vec<[f32; 4]>, Unsupported> {
     generate_timed(mesh, &mut crate::report::Timings::default())
 }
 
@@ -76,7 +76,7 @@ pub fn generate(mesh: &TriMesh) -> Result<Vec<Option<[f32; 4]>>, Unsupported> {
 pub fn generate_timed(
     mesh: &TriMesh,
     timings: &mut crate::report::Timings,
-) -> Result<Vec<Option<[f32; 4]>>, Unsupported> {
+) -> Result<Vec<[f32; 4]>, Unsupported> {
     let n_faces = mesh.indices.len() / 3;
     if n_faces.checked_mul(3).is_none_or(|n| n >= (u32::MAX as usize) - 4) {
         return Err(Unsupported::TooLarge);
@@ -86,7 +86,7 @@ pub fn generate_timed(
         return Err(Unsupported::IndexOutOfRange);
     }
     let c = Corners { mesh };
-    let mut out: Vec<Option<[f32; 4]>> = vec![None; mesh.indices.len()];
+    let mut out: Vec<[f32; 4]> = vec![[0.0; 4]; mesh.indices.len()];
     if n_faces == 0 {
         return Ok(out);
     }
@@ -107,7 +107,7 @@ pub fn generate_timed(
         let range = grp.start[g] as usize..grp.start[g + 1] as usize;
         for (&k, v) in grp.members[range.clone()].iter().zip(&vals[range]) {
             let corner = 3 * tri.order[(k / 3) as usize] as usize + (k % 3) as usize;
-            out[corner] = Some([v[0], v[1], v[2], sign]);
+            out[corner] = [v[0], v[1], v[2], sign];
         }
     }
     if ng < tri.order.len() {
@@ -156,7 +156,7 @@ fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut 
 
 /// Corners of degenerate triangles copy the output of the first good corner (in the
 /// reference's good-triangle order) with the same welded id, if any.
-fn degenerate(welded: &[u32], tri: &triangles::Triangles, n_faces: usize, out: &mut [Option<[f32; 4]>]) {
+fn degenerate(welded: &[u32], tri: &triangles::Triangles, n_faces: usize, out: &mut [[f32; 4]]) {
     let ng = tri.n_good;
     let corner = |k: usize| 3 * tri.order[k / 3] as usize + k % 3;
     let mut first_good = vec![u32::MAX; 3 * n_faces];

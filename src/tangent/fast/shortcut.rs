@@ -19,6 +19,7 @@
 //! input vertices (corners sharing an index are equal) instead of the corners.
 
 use super::math::canon_bits;
+use crate::scene::weld::{first_equal, hash_words};
 use super::Corners;
 use rayon::prelude::*;
 
@@ -42,75 +43,36 @@ pub(crate) fn weld(c: &Corners, order: &[u32], n_good: usize) -> Option<Vec<u32>
         }
         last[v] = id as u32;
     }
-    // Each used vertex's class: the first vertex (by index) with equal canonical bits. Vertices
-    // are split into shards by hash (equal keys share a shard), and each shard is resolved with
-    // its own small open-addressing table of vertex ids, in parallel.
+    // Each used vertex's class: the first vertex (by index) with equal canonical bits.
     let key = |v: usize| {
         let (p, n, u) = (c.mesh.positions[v], c.mesh.normals[v], c.mesh.uvs[v]);
         [p[0], p[1], p[2], n[0], n[1], n[2], u[0], u[1]]
     };
     const HUGE: f32 = f32::MAX / 4.0;
+    let unusable = (0..n_vertices).into_par_iter().with_min_len(1 << 14).any(|v| {
+        let all = key(v);
+        first[v] != u32::MAX && (all.iter().any(|x| x.is_nan()) || all[..3].iter().any(|x| !(x.abs() < HUGE)))
+    });
+    if unusable {
+        return None; // no shortcut for NaN or huge coordinates
+    }
     let hashes: Vec<u64> = (0..n_vertices)
         .into_par_iter()
         .with_min_len(1 << 14)
-        .map(|v| {
-            let all = key(v);
-            if first[v] == u32::MAX {
-                return 0;
-            }
-            if all.iter().any(|x| x.is_nan()) || all[..3].iter().any(|x| !(x.abs() < HUGE)) {
-                return u64::MAX; // no shortcut for NaN or huge coordinates
-            }
-            all.map(canon_bits).iter().fold(0u64, |h, &x| (h.rotate_left(5) ^ x as u64).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95)) | 1
-        })
+        .map(|v| if first[v] == u32::MAX { 0 } else { hash_words(key(v).map(canon_bits)) })
         .collect();
-    if hashes.par_iter().any(|&h| h == u64::MAX) {
-        return None;
-    }
-    const SHARD_BITS: u32 = 4;
-    let mut shards: Vec<Vec<u32>> = vec![Vec::new(); 1 << SHARD_BITS];
-    for (v, &h) in hashes.iter().enumerate() {
-        if h != 0 {
-            shards[(h >> (64 - SHARD_BITS)) as usize].push(v as u32);
+    let class = first_equal(&hashes, |a, b| key(a).map(canon_bits) == key(b).map(canon_bits));
+    drop(hashes);
+    for v in 0..n_vertices {
+        let r = class[v] as usize;
+        if r != v {
+            if key(r).map(f32::to_bits) != key(v).map(f32::to_bits) {
+                return None; // zeros of different signs: the representative decides the bits
+            }
+            first[r] = first[r].min(first[v]);
+            last[r] = last[r].max(last[v]);
         }
     }
-    let resolved: Option<Vec<Vec<(u32, u32)>>> = shards
-        .par_iter()
-        .map(|vs| {
-            let mask = (2 * vs.len()).next_power_of_two().max(16) - 1;
-            let mut slots: Vec<(u32, u32)> = vec![(u32::MAX, 0); mask + 1];
-            let mut out = Vec::new();
-            for &v in vs {
-                let h = hashes[v as usize];
-                let all = key(v as usize);
-                let mut i = h as usize & mask;
-                loop {
-                    let (s, t) = slots[i];
-                    if s == u32::MAX {
-                        slots[i] = (v, (h >> 32) as u32);
-                        break;
-                    }
-                    if t == (h >> 32) as u32 && key(s as usize).map(canon_bits) == all.map(canon_bits) {
-                        if key(s as usize).map(f32::to_bits) != all.map(f32::to_bits) {
-                            return None; // zeros of different signs: the representative decides the bits
-                        }
-                        out.push((v, s));
-                        break;
-                    }
-                    i = (i + 1) & mask;
-                }
-            }
-            Some(out)
-        })
-        .collect();
-    let mut class: Vec<u32> = (0..n_vertices as u32).collect();
-    for (v, rep) in resolved?.into_iter().flatten() {
-        let (v, rep) = (v as usize, rep as usize);
-        first[rep] = first[rep].min(first[v]);
-        last[rep] = last[rep].max(last[v]);
-        class[v] = rep as u32;
-    }
-    drop((hashes, shards));
     let class_of = |id: usize| class[idx[id] as usize] as usize;
     let id_of = |k: usize| 3 * order[k / 3] as usize + k % 3;
     // Fewer than 3 edges can have the largest i0 (see the module comment).
