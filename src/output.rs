@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 /// A set of files that appear together or not at all (a `.gltf` and its `.bin`, say).
 #[derive(Default)]
 pub struct Outputs {
-    files: Vec<(PathBuf, Vec<u8>)>,
+    /// Each file as parts written one after the other (a GLB's header and JSON, then its
+    /// binary chunk, need not be copied into one buffer).
+    files: Vec<(PathBuf, Vec<Vec<u8>>)>,
 }
 
 impl Outputs {
@@ -18,7 +20,11 @@ impl Outputs {
     }
     /// Queues `bytes` to be written at `path`.
     pub fn add(&mut self, path: impl Into<PathBuf>, bytes: Vec<u8>) {
-        self.files.push((path.into(), bytes));
+        self.files.push((path.into(), vec![bytes]));
+    }
+    /// Queues a file made of `parts`, in order.
+    pub fn add_parts(&mut self, path: impl Into<PathBuf>, parts: Vec<Vec<u8>>) {
+        self.files.push((path.into(), parts));
     }
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
         self.files.iter().map(|(p, _)| p.as_path())
@@ -34,8 +40,8 @@ impl Outputs {
             }
         }
         let mut temps: Vec<(PathBuf, PathBuf)> = Vec::new();
-        for (path, bytes) in &self.files {
-            match write_temp(path, bytes) {
+        for (path, parts) in &self.files {
+            match write_temp(path, parts) {
                 Ok(tmp) => temps.push((tmp, path.clone())),
                 Err(e) => {
                     for (tmp, _) in &temps {
@@ -59,14 +65,14 @@ impl Outputs {
 
 /// Writes one file atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = write_temp(path, bytes)?;
+    let tmp = write_temp(path, &[bytes])?;
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         Error::output(path, e)
     })
 }
 
-fn write_temp(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
+fn write_temp(path: &Path, parts: &[impl AsRef<[u8]>]) -> Result<PathBuf> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -75,7 +81,9 @@ fn write_temp(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
     let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
+        for bytes in parts {
+            f.write_all(bytes.as_ref())?;
+        }
         f.sync_all()
     })();
     if let Err(e) = result {

@@ -17,3 +17,14 @@ impl Timings {
         out
     }
 }
+
+/// With `BUMPBAKE_MEMTRACE` set, prints the process's resident and peak memory after `stage` to
+/// stderr (Linux only): how the memory figures in `docs/tangents-bench.md` were found.
+pub fn mem_mark(stage: &str) {
+    if std::env::var_os("BUMPBAKE_MEMTRACE").is_none() {
+        return;
+    }
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let field = |k: &str| status.lines().find(|l| l.starts_with(k)).map(|l| l[k.len()..].trim().to_string()).unwrap_or_default();
+    eprintln!("memtrace {stage}: rss {} peak {}", field("VmRSS:"), field("VmHWM:"));
+}

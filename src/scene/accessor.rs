@@ -111,15 +111,46 @@ impl Stream {
 
     /// The whole stream as `N`-component float vectors.
     pub fn to_f32<const N: usize>(&self) -> Vec<[f32; N]> {
-        (0..self.len())
-            .map(|i| {
-                let mut v = [0.0; N];
-                for (c, x) in v.iter_mut().enumerate().take(self.format.components()) {
+        let mut out = vec![[0.0; N]; self.len()];
+        self.for_each_element(|i, v| {
+            for (x, &y) in out[i].iter_mut().zip(v) {
+                *x = y;
+            }
+        });
+        out
+    }
+
+    /// An unsigned integer scalar stream (indices) as integers: a float would round them above
+    /// 2^24. Other formats give their first component, truncated.
+    pub fn to_u32(&self) -> Vec<u32> {
+        match (self.format.component_type, self.format.components()) {
+            (UNSIGNED_BYTE, 1) => self.data.iter().map(|&b| b as u32).collect(),
+            (UNSIGNED_SHORT, 1) => self.data.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]]) as u32).collect(),
+            (UNSIGNED_INT, 1) => self.data.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect(),
+            _ => (0..self.len()).map(|i| self.get(i, 0) as u32).collect(),
+        }
+    }
+
+    /// Calls `f` with each element's index and components as floats (at most 16: a MAT4).
+    /// Float streams are read straight from their bytes.
+    pub fn for_each_element(&self, mut f: impl FnMut(usize, &[f32])) {
+        let n = self.format.components().min(16);
+        let mut v = [0.0f32; 16];
+        if self.format.component_type == FLOAT && n > 0 {
+            for (i, e) in self.data.chunks_exact(4 * n).enumerate() {
+                for (x, b) in v.iter_mut().zip(e.chunks_exact(4)) {
+                    *x = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+                }
+                f(i, &v[..n]);
+            }
+        } else {
+            for i in 0..self.len() {
+                for (c, x) in v.iter_mut().enumerate().take(n) {
                     *x = self.get(i, c);
                 }
-                v
-            })
-            .collect()
+                f(i, &v[..n]);
+            }
+        }
     }
 
     /// Copies the elements named by `order` into a new stream (a gather).
@@ -137,5 +168,29 @@ impl Stream {
     pub fn elem(&self, i: usize) -> &[u8] {
         let s = self.format.elem_size();
         &self.data[i * s..(i + 1) * s]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn indices_above_two_to_the_24_are_exact() {
+        let big = [16_777_217u32, u32::MAX - 1, 7];
+        let s = Stream { format: Format { component_type: UNSIGNED_INT, ty: "SCALAR".into(), normalized: false }, data: big.iter().flat_map(|i| i.to_le_bytes()).collect(), template: None };
+        assert_eq!(s.to_u32(), big);
+        let s = Stream { format: Format { component_type: UNSIGNED_SHORT, ty: "SCALAR".into(), normalized: false }, data: vec![0xff, 0xff, 1, 0], template: None };
+        assert_eq!(s.to_u32(), [65535, 1]);
+    }
+
+    #[test]
+    fn float_and_normalised_streams_read_the_same_through_both_paths() {
+        let f = Stream::from_f32("VEC3", &[[1.5, -0.0, 3e38], [f32::MIN_POSITIVE, 2.0, -7.25]]);
+        assert_eq!(f.to_f32::<3>(), [[1.5, -0.0, 3e38], [f32::MIN_POSITIVE, 2.0, -7.25]]);
+        assert_eq!(f.to_f32::<2>(), [[1.5, -0.0], [f32::MIN_POSITIVE, 2.0]]);
+        assert_eq!(f.to_f32::<4>(), [[1.5, -0.0, 3e38, 0.0], [f32::MIN_POSITIVE, 2.0, -7.25, 0.0]]);
+        let n = Stream { format: Format { component_type: UNSIGNED_BYTE, ty: "VEC2".into(), normalized: true }, data: vec![255, 0, 51, 102], template: None };
+        assert_eq!(n.to_f32::<2>(), [[1.0, 0.0], [0.2, 0.4]]);
     }
 }

@@ -10,6 +10,25 @@ const GLB_JSON: u32 = 0x4E4F534A;
 const GLB_BIN: u32 = 0x004E4942;
 
 pub fn read_glb(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
+    let (json, bin) = parse_glb(path, bytes)?;
+    build(path, json, bin.map(|r| bytes[r].to_vec()), opts)
+}
+
+/// [`read_glb`] on bytes it may keep: the binary chunk becomes the buffer in place, without a
+/// second copy of the file in memory.
+pub fn read_glb_owned(path: &Path, mut bytes: Vec<u8>, opts: &ReadOptions) -> Result<Scene> {
+    let (json, bin) = parse_glb(path, &bytes)?;
+    let bin = bin.map(|r| {
+        bytes.truncate(r.end);
+        bytes.drain(..r.start);
+        bytes.shrink_to_fit();
+        bytes
+    });
+    build(path, json, bin, opts)
+}
+
+/// The JSON and where the binary chunk lies.
+fn parse_glb(path: &Path, bytes: &[u8]) -> Result<(Value, Option<std::ops::Range<usize>>)> {
     let bad = |m: String| Error::input(path, m);
     if bytes.len() < 12 {
         return Err(bad(format!("truncated GLB: {} bytes, the header alone needs 12", bytes.len())));
@@ -28,7 +47,7 @@ pub fn read_glb(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> 
     }
     let mut at = 12;
     let mut json_chunk: Option<&[u8]> = None;
-    let mut bin: Option<&[u8]> = None;
+    let mut bin: Option<std::ops::Range<usize>> = None;
     while at + 8 <= total {
         let len = word(at) as usize;
         let kind = word(at + 4);
@@ -38,14 +57,13 @@ pub fn read_glb(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> 
         })?;
         match kind {
             GLB_JSON if json_chunk.is_none() => json_chunk = Some(&bytes[start..end]),
-            GLB_BIN if bin.is_none() && json_chunk.is_some() => bin = Some(&bytes[start..end]),
+            GLB_BIN if bin.is_none() && json_chunk.is_some() => bin = Some(start..end),
             _ => {}
         }
         at = end + (4 - end % 4) % 4;
     }
     let json_bytes = json_chunk.ok_or_else(|| bad("GLB has no JSON chunk".into()))?;
-    let json = parse_json(path, json_bytes)?;
-    build(path, json, bin.map(|b| b.to_vec()), opts)
+    Ok((parse_json(path, json_bytes)?, bin))
 }
 
 pub fn read_gltf(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {

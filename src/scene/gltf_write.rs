@@ -165,6 +165,8 @@ pub fn write(scene: &Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs,
     view_refs(&mut json, &mut |i| *i = view_map[*i].expect("kept view"));
     stats.buffer_views_dropped = n_views - view_keep.len();
     if let Some(views) = json.get_mut("bufferViews").and_then(|v| v.as_array_mut()) {
+        let total: usize = views.iter().map(|v| v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize + 3).sum();
+        bin.reserve_exact(total + pending_views.iter().map(|(b, _)| b.len() + 3).sum::<usize>() + 3);
         for v in views.iter_mut() {
             let b = v.get("buffer").and_then(as_index).unwrap_or(0);
             let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
@@ -213,7 +215,7 @@ pub fn write(scene: &Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs,
     }
 
     if glb {
-        files.add(out, glb_bytes(&json, &bin));
+        files.add_parts(out, glb_parts(&json, bin));
     } else {
         let mut text = serde_json::to_vec_pretty(&json).map_err(|e| Error::output(out, e))?;
         text.push(b'\n');
@@ -249,26 +251,26 @@ fn pad4(buf: &mut Vec<u8>, fill: u8) {
     }
 }
 
-fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
+/// The GLB container: header and JSON chunk, then the binary chunk (`bin`, not copied).
+fn glb_parts(json: &Value, mut b: Vec<u8>) -> Vec<Vec<u8>> {
     let mut j = serde_json::to_vec(json).expect("a Value always serialises");
     pad4(&mut j, b' ');
-    let mut b = bin.to_vec();
     pad4(&mut b, 0);
     let has_bin = !b.is_empty() || json.get("buffers").is_some();
     let total = 12 + 8 + j.len() + if has_bin { 8 + b.len() } else { 0 };
-    let mut out = Vec::with_capacity(total);
+    let mut out = Vec::with_capacity(12 + 8 + j.len() + 8);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
     out.extend_from_slice(&(total as u32).to_le_bytes());
     out.extend_from_slice(&(j.len() as u32).to_le_bytes());
     out.extend_from_slice(&0x4E4F534Au32.to_le_bytes());
     out.extend_from_slice(&j);
-    if has_bin {
-        out.extend_from_slice(&(b.len() as u32).to_le_bytes());
-        out.extend_from_slice(&0x004E4942u32.to_le_bytes());
-        out.extend_from_slice(&b);
+    if !has_bin {
+        return vec![out];
     }
-    out
+    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(&0x004E4942u32.to_le_bytes());
+    vec![out, b]
 }
 
 /// Copies an external image next to the output (unless it is already there).

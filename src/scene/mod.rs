@@ -121,6 +121,10 @@ impl Scene {
     /// Reads an `.obj`, `.gltf` or `.glb` file (GLB is recognised by its magic, not its name).
     pub fn read(path: &Path, opts: &ReadOptions) -> Result<Scene> {
         let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        if ext != "obj" && bytes.starts_with(b"glTF") {
+            return gltf_read::read_glb_owned(path, bytes, opts);
+        }
         Scene::read_bytes(path, &bytes, opts)
     }
 
@@ -267,8 +271,13 @@ impl Scene {
         for (name, s) in &attributes {
             let used = name == "POSITION" || name == "NORMAL" || name.starts_with("TEXCOORD_");
             if used && s.format.component_type == FLOAT {
-                let n = s.format.components();
-                if let Some(bad) = (0..s.len()).find(|&i| (0..n).any(|c| !s.get(i, c).is_finite())) {
+                let mut bad = None;
+                s.for_each_element(|i, v| {
+                    if bad.is_none() && !v.iter().all(|x| x.is_finite()) {
+                        bad = Some(i);
+                    }
+                });
+                if let Some(bad) = bad {
                     return Err(self.err(format!("{where_}: {name} {bad} is not finite (NaN or infinity)")));
                 }
             }
@@ -285,7 +294,7 @@ impl Scene {
                 if s.format.ty != "SCALAR" || !matches!(s.format.component_type, UNSIGNED_BYTE | UNSIGNED_SHORT | UNSIGNED_INT) {
                     return Err(self.err(format!("{where_}: index accessor {idx} is not an unsigned integer scalar")));
                 }
-                let v: Vec<u32> = (0..s.len()).map(|i| s.get(i, 0) as u32).collect();
+                let v = s.to_u32();
                 if let Some((k, bad)) = v.iter().enumerate().find(|(_, &x)| x as usize >= count) {
                     return Err(self.err(format!("{where_}: index {bad} at position {k} is out of range (the primitive has {count} vertices)")));
                 }
@@ -305,6 +314,11 @@ impl Scene {
     /// Puts a primitive back: its streams become new accessors in a new buffer, and the
     /// primitive's JSON points at them. Old accessors are left for the writer to drop.
     pub fn set_primitive(&mut self, r: PrimRef, p: &Primitive) {
+        // Room for every stream at once: one reallocation, not a doubling per stream.
+        let bytes: usize = p.attributes.iter().chain(p.targets.iter().flatten()).map(|(_, s)| s.data.len() + 3).sum::<usize>() + 4 * p.indices.len() + 3;
+        if let Some(last) = self.buffers.last_mut() {
+            last.reserve_exact(bytes);
+        }
         let mut attrs = serde_json::Map::new();
         for (name, s) in &p.attributes {
             let i = self.push_accessor(s, Some(34962), name == "POSITION");
@@ -383,13 +397,12 @@ impl Scene {
             let n = s.format.components();
             let mut lo = vec![f32::INFINITY; n];
             let mut hi = vec![f32::NEG_INFINITY; n];
-            for i in 0..s.len() {
-                for c in 0..n {
-                    let v = s.get(i, c);
-                    lo[c] = lo[c].min(v);
-                    hi[c] = hi[c].max(v);
+            s.for_each_element(|_, v| {
+                for (c, &x) in v.iter().enumerate() {
+                    lo[c] = lo[c].min(x);
+                    hi[c] = hi[c].max(x);
                 }
-            }
+            });
             acc["min"] = json!(lo);
             acc["max"] = json!(hi);
         }

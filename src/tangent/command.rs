@@ -38,8 +38,11 @@ pub struct TangentsReport {
 pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     let mut t = Timings::default();
     let mut scene = t.time("read", || Scene::read(&job.input, &job.read))?;
+    crate::report::mem_mark("read");
     let prims = t.time("tangents", || apply(&mut scene, &job.apply))?;
+    crate::report::mem_mark("tangents");
     let (mut files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
+    crate::report::mem_mark("encode");
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &scene.dependencies()));
     }

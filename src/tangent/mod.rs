@@ -78,11 +78,13 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
         (n, p.indices.as_slice(), frames)
     };
     drop((positions, uvs));
+    crate::report::mem_mark("engine");
     if !uv_v_up {
         // glTF UVs run v down: the output's w is the reference's sign negated (see the conventions).
         frames.par_iter_mut().with_min_len(1 << 12).for_each(|t| t[3] = -t[3]);
     }
     let fallback = fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
+    crate::report::mem_mark("repair");
 
     let bitangents: Vec<[f32; 3]> = if opts.bitangents {
         frames
@@ -104,6 +106,7 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
     }
     let mut out = split_corners(p, &["TANGENT", "_BITANGENT"], &extra);
     out.mode = 4;
+    crate::report::mem_mark("split");
     let stats = FrameStats {
         vertices_in: p.vertex_count(),
         vertices_out: out.vertex_count(),

@@ -86,9 +86,8 @@ pub fn generate_timed(
         return Err(Unsupported::IndexOutOfRange);
     }
     let c = Corners { mesh };
-    let mut out: Vec<[f32; 4]> = vec![[0.0; 4]; mesh.indices.len()];
     if n_faces == 0 {
-        return Ok(out);
+        return Ok(vec![[0.0; 4]; mesh.indices.len()]);
     }
     let mut tri = timings.time("triangles", || triangles::Triangles::build(&c));
     let ng = tri.n_good;
@@ -98,35 +97,60 @@ pub fn generate_timed(
     });
     let w = &welded[..3 * ng];
     let nb = timings.time("neighbors", || neighbors::build(w, 3 * n_faces, short_tail));
+    crate::report::mem_mark("engine neighbors");
     let mut grp = timings.time("groups", || groups::build(w, &nb, &mut tri));
+    crate::report::mem_mark("engine groups");
     drop(nb);
-    let vals = timings.time("accumulate", || accumulate_all(&c, w, &tri, &mut grp));
-    let t_out = std::time::Instant::now();
-    for g in 0..grp.rep.len() {
-        let sign = if grp.orient[g] { 1.0 } else { -1.0 };
-        let range = grp.start[g] as usize..grp.start[g + 1] as usize;
-        for (&k, v) in grp.members[range.clone()].iter().zip(&vals[range]) {
-            let corner = 3 * tri.order[(k / 3) as usize] as usize + (k % 3) as usize;
-            out[corner] = [v[0], v[1], v[2], sign];
+    // Sums are made and scattered to corners a slice of groups at a time, so that only a slice
+    // of them is ever held beside the output.
+    let mut out: Vec<[f32; 4]> = vec![[0.0; 4]; mesh.indices.len()];
+    let (mut t_acc, mut t_out) = (0.0, 0.0);
+    let n_groups = grp.rep.len();
+    let mut g0 = 0;
+    while g0 < n_groups {
+        let limit = grp.start[g0] as usize + PASS;
+        let g1 = (g0 + 1).max(grp.start.partition_point(|&x| (x as usize) <= limit) - 1).min(n_groups);
+        let t0 = std::time::Instant::now();
+        let vals = accumulate_all(&c, w, &tri, &mut grp, g0..g1);
+        let t1 = std::time::Instant::now();
+        let base = grp.start[g0] as usize;
+        for g in g0..g1 {
+            let sign = if grp.orient[g] { 1.0 } else { -1.0 };
+            let range = grp.start[g] as usize..grp.start[g + 1] as usize;
+            for (&k, v) in grp.members[range.clone()].iter().zip(&vals[range.start - base..range.end - base]) {
+                let corner = 3 * tri.order[(k / 3) as usize] as usize + (k % 3) as usize;
+                out[corner] = [v[0], v[1], v[2], sign];
+            }
         }
+        t_acc += (t1 - t0).as_secs_f64() * 1e3;
+        t_out += t1.elapsed().as_secs_f64() * 1e3;
+        g0 = g1;
     }
+    crate::report::mem_mark("engine accumulate");
+    timings.stages.push(("accumulate".into(), t_acc));
+    let t_deg = std::time::Instant::now();
     if ng < tri.order.len() {
         degenerate(&welded, &tri, n_faces, &mut out);
     }
-    timings.stages.push(("output".into(), t_out.elapsed().as_secs_f64() * 1e3));
+    timings.stages.push(("output".into(), t_out + t_deg.elapsed().as_secs_f64() * 1e3));
     Ok(out)
 }
 
-/// Runs [`accumulate::group_tangents`] on every group, in parallel batches of whole groups.
-/// Sorts each group's members (the reference sums in triangle order).
-fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut groups::Groups) -> Vec<V3> {
+/// Members per pass of the sums (see [`generate_timed`]).
+const PASS: usize = 1 << 18;
+
+/// Runs [`accumulate::group_tangents`] on the groups in `groups`, in parallel batches of whole
+/// groups; returns their members' sums. Sorts each group's members (the reference sums in
+/// triangle order).
+fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut groups::Groups, groups: std::ops::Range<usize>) -> Vec<V3> {
     const BATCH: usize = 8192;
-    let n_groups = grp.rep.len();
-    let mut vals = vec![[0.0f32; 3]; grp.members.len()];
+    let n_groups = groups.end;
+    let (lo, hi) = (grp.start[groups.start] as usize, grp.start[groups.end] as usize);
+    let mut vals = vec![[0.0f32; 3]; hi - lo];
     let mut batches = Vec::new();
-    let mut rest_m = grp.members.as_mut_slice();
+    let mut rest_m = &mut grp.members[lo..hi];
     let mut rest_v = vals.as_mut_slice();
-    let mut g0 = 0;
+    let mut g0 = groups.start;
     while g0 < n_groups {
         let mut g1 = g0 + 1;
         while g1 < n_groups && ((grp.start[g1] - grp.start[g0]) as usize) < BATCH {
