@@ -120,6 +120,19 @@ impl Stream {
         out
     }
 
+    /// The stream as `N`-component float vectors, borrowed from its bytes when they are
+    /// little-endian `f32`s with `N` components and suitably aligned (every float stream read from
+    /// a file, in practice), else converted with [`Self::to_f32`].
+    pub fn as_f32<const N: usize>(&self) -> std::borrow::Cow<'_, [[f32; N]]> {
+        let n = self.len() * N * 4;
+        if cfg!(target_endian = "little") && self.format.component_type == FLOAT && self.format.components() == N {
+            if let Ok(v) = bytemuck::try_cast_slice::<u8, f32>(&self.data[..n]) {
+                return std::borrow::Cow::Borrowed(v.as_chunks::<N>().0);
+            }
+        }
+        std::borrow::Cow::Owned(self.to_f32())
+    }
+
     /// An unsigned integer scalar stream (indices) as integers: a float would round them above
     /// 2^24. Other formats give their first component, truncated.
     pub fn to_u32(&self) -> Vec<u32> {
@@ -192,5 +205,13 @@ mod tests {
         assert_eq!(f.to_f32::<4>(), [[1.5, -0.0, 3e38, 0.0], [f32::MIN_POSITIVE, 2.0, -7.25, 0.0]]);
         let n = Stream { format: Format { component_type: UNSIGNED_BYTE, ty: "VEC2".into(), normalized: true }, data: vec![255, 0, 51, 102], template: None };
         assert_eq!(n.to_f32::<2>(), [[1.0, 0.0], [0.2, 0.4]]);
+        assert_eq!(&*n.as_f32::<2>(), [[1.0, 0.0], [0.2, 0.4]]);
+        assert_eq!(&*f.as_f32::<3>(), &*f.to_f32::<3>());
+        assert!(matches!(f.as_f32::<3>(), std::borrow::Cow::Borrowed(_)) || f.data.as_ptr() as usize % 4 != 0);
+        // Misaligned bytes are converted, not misread.
+        let mut shifted = vec![0u8];
+        shifted.extend_from_slice(&f.data);
+        let g = Stream { data: shifted[1..].to_vec(), ..f.clone() };
+        assert_eq!(&*g.as_f32::<3>(), &*f.to_f32::<3>());
     }
 }

@@ -56,10 +56,11 @@ pub fn primitive_with_tangents(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: 
 /// [`primitive_with_tangents`], with what it did.
 pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
     let uv_name = format!("TEXCOORD_{uv_set}");
-    let mut positions = p.positions();
-    // Without POSITION (callers skip such primitives) the surface is a point.
-    positions.resize(p.vertex_count(), [0.0; 3]);
-    let uvs: Vec<[f32; 2]> = p.attr(&uv_name).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
+    let n_vertices = p.vertex_count();
+    // Borrowed from the streams where possible. Without POSITION (callers skip such primitives)
+    // the surface is a point.
+    let positions = p.attr("POSITION").map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 3]; n_vertices].into());
+    let uvs = p.attr(&uv_name).map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
 
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
@@ -71,9 +72,9 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
         let cu: Vec<[f32; 2]> = p.indices.iter().map(|&i| uvs[i as usize]).collect();
         corner_ids = (0..p.indices.len() as u32).collect();
         let frames = generate_with_stack(&TriMesh { positions: &cp, normals: &n, uvs: &cu, indices: &corner_ids }, opts.engine);
-        (n, corner_ids.as_slice(), frames)
+        (n.into(), corner_ids.as_slice(), frames)
     } else {
-        let n: Vec<[f32; 3]> = p.attr("NORMAL").map(|s| s.to_f32()).unwrap_or_default();
+        let n = p.attr("NORMAL").map(|s| s.as_f32()).unwrap_or_default();
         let frames = generate_with_stack(&TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices }, opts.engine);
         (n, p.indices.as_slice(), frames)
     };
@@ -95,7 +96,7 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
     } else {
         Vec::new()
     };
-    let flat_normals: Vec<[f32; 3]> = if generated_normals { normals } else { Vec::new() };
+    let flat_normals: &[[f32; 3]] = if generated_normals { &normals } else { &[] };
     let mut extra = Vec::new();
     if generated_normals {
         extra.push(CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: flat_normals.as_flattened() });

@@ -74,18 +74,14 @@ impl Triangles {
         let mut order = Vec::with_capacity(n_faces);
         order.extend((0..n_faces).filter(|&f| !degen[f]).map(|f| f as u32));
         order.extend((0..n_faces).filter(|&f| degen[f]).map(|f| f as u32));
-        let infos: Vec<Info> =
-            order[..n_good].par_iter().map(|&f| info(c, f as usize)).collect();
-        let mut s = Vec::with_capacity(n_good);
-        let mut t = Vec::with_capacity(n_good);
-        let mut orient = Vec::with_capacity(n_good);
-        let mut gwa = Vec::with_capacity(n_good);
-        for i in infos {
-            s.push(i.s);
-            t.push(i.t);
-            orient.push(i.orient);
-            gwa.push(i.gwa);
-        }
+        // Straight into the four arrays: no temporary array of records.
+        let ((s, t), (orient, gwa)): ((Vec<V3>, Vec<V3>), (Vec<bool>, Vec<bool>)) = order[..n_good]
+            .par_iter()
+            .map(|&f| {
+                let i = info(c, f as usize);
+                ((i.s, i.t), (i.orient, i.gwa))
+            })
+            .unzip();
         Triangles { order, n_good, s, t, orient, gwa }
     }
 }
