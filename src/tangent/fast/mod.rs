@@ -103,7 +103,8 @@ pub fn generate_timed(
     drop(nb);
     // Sums are made and scattered to corners a slice of groups at a time, so that only a slice
     // of them is ever held beside the output.
-    let mut out: Vec<[f32; 4]> = vec![[0.0; 4]; mesh.indices.len()];
+    // Zeroed in parallel: the first touch of each page (a page fault) is shared between threads.
+    let mut out: Vec<[f32; 4]> = (0..mesh.indices.len()).into_par_iter().with_min_len(1 << 14).map(|_| [0.0; 4]).collect();
     let (mut t_acc, mut t_out) = (0.0, 0.0);
     let n_groups = grp.rep.len();
     let mut g0 = 0;

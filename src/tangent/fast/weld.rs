@@ -103,7 +103,11 @@ impl Buckets {
             .collect::<Vec<_>>()
             .into_iter()
             .fold(EMPTY, BBox::union);
-        if pos.is_empty() {
+        Self::from_bbox(bbox, pos.len())
+    }
+    /// The split for a list of `n` entries with bounding box `bbox`.
+    fn from_bbox(bbox: BBox, n: usize) -> Option<Buckets> {
+        if n == 0 {
             return None;
         }
         let (mn, mx) = bbox.bounds();
@@ -127,24 +131,40 @@ fn list_positions(c: &Corners, order: &[u32]) -> Vec<V3> {
 /// The welded id [`weld`] gives list entries `ks`, replaying only the buckets they fall in.
 pub(crate) fn welded_of(c: &Corners, order: &[u32], ks: &[usize]) -> Vec<u32> {
     let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
-    let pos = list_positions(c, order);
-    let Some(bk) = Buckets::new(&pos) else { return Vec::new() };
-    let mut wanted: Vec<usize> = ks.iter().map(|&k| bk.of(&pos[k])).collect();
-    wanted.sort_unstable();
-    wanted.dedup();
-    let mut answer: HashMap<usize, u32> = ks.iter().map(|&k| (k, id_of(k))).collect();
+    let pos_of = |k: usize| c.pos(id_of(k) as usize);
+    let n = order.len() * 3;
+    let bbox = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|ch| {
+            let mut b = EMPTY;
+            (ch * CHUNK..n.min((ch + 1) * CHUNK)).for_each(|k| b.grow(pos_of(k)));
+            b
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold(EMPTY, BBox::union);
+    let Some(bk) = Buckets::from_bbox(bbox, n) else { return Vec::new() };
+    let mut wanted = vec![false; GROUPS];
+    ks.iter().for_each(|&k| wanted[bk.of(&pos_of(k))] = true);
+    // Each wanted bucket's entries in list order (the reference's stable bucket sort).
+    let found: Vec<Vec<(u16, Tmp)>> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|ch| {
+            (ch * CHUNK..n.min((ch + 1) * CHUNK))
+                .filter_map(|k| {
+                    let p = pos_of(k);
+                    let g = bk.of(&p);
+                    wanted[g].then_some((g as u16, Tmp { p, k: k as u32 }))
+                })
+                .collect()
+        })
+        .collect();
     let mut bufs: Vec<Vec<Tmp>> = vec![Vec::new(); GROUPS];
-    for g in wanted {
-        bufs[g].push(Tmp { p: [0.0; 3], k: 0 }); // marks the bucket as wanted
+    for (g, t) in found.into_iter().flatten() {
+        bufs[g as usize].push(t);
     }
-    for (k, p) in pos.iter().enumerate() {
-        let b = &mut bufs[bk.of(p)];
-        if !b.is_empty() {
-            b.push(Tmp { p: *p, k: k as u32 });
-        }
-    }
+    let mut answer: HashMap<usize, u32> = ks.iter().map(|&k| (k, id_of(k))).collect();
     for mut buf in bufs.into_iter().filter(|b| !b.is_empty()) {
-        buf.remove(0);
         let mut reps = vec![SELF; buf.len()];
         merge(c, order, &mut buf, &mut reps);
         for (t, &r) in buf.iter().zip(&reps) {
