@@ -5,7 +5,8 @@
 //! wound so that the UV orientation is preserved: the exact frame at a vertex is
 //! `t = normalize(P_u - (P_u·N) N)` with sign `+1`. For each engine the bench reports the angular
 //! error against that exact tangent and against the reference engine (`bevy_mikktspace`), sign
-//! errors, corners without a frame, and throughput (median of several runs).
+//! errors, corners without a frame, and throughput (median of several runs). Real meshes
+//! (`--mesh FILE`) have no exact tangent: they are compared with the reference only.
 
 #![forbid(unsafe_code)]
 
@@ -27,6 +28,8 @@ pub enum Surface {
     WavyGrid,
     /// A flat disk of triangles all sharing the centre vertex (planar UVs).
     Fan,
+    /// A mesh read from a file (its rows carry the file name).
+    Mesh,
 }
 
 impl Surface {
@@ -36,6 +39,7 @@ impl Surface {
             Surface::Torus => "torus",
             Surface::WavyGrid => "wavy-grid",
             Surface::Fan => "fan",
+            Surface::Mesh => "mesh",
         }
     }
     pub fn parse(s: &str) -> Option<Self> {
@@ -64,13 +68,40 @@ pub struct Case {
     pub normals: Vec<[f32; 3]>,
     pub uvs: Vec<[f32; 2]>,
     pub indices: Vec<u32>,
-    /// Exact unit tangent per vertex (sign is +1 everywhere).
+    /// Exact unit tangent per vertex (sign is +1 everywhere); empty for a mesh from a file.
     pub exact: Vec<[f32; 3]>,
+    /// The surface's name, or the file name of a mesh.
+    pub label: String,
 }
 
 impl Case {
     pub fn triangles(&self) -> usize {
         self.indices.len() / 3
+    }
+    /// Every triangle primitive of a mesh file with UVs (set 0) in one mesh; primitives without
+    /// normals get the smooth normals an OBJ without them gets.
+    pub fn from_file(path: &std::path::Path) -> crate::error::Result<Case> {
+        let scene = crate::scene::Scene::read(path, &Default::default())?;
+        let label = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let mut c = Case { surface: Surface::Mesh, positions: vec![], normals: vec![], uvs: vec![], indices: vec![], exact: vec![], label };
+        for r in scene.primitives() {
+            let p = crate::tangent::apply::to_triangle_list(scene.primitive(r)?);
+            let Some(uv) = p.attr("TEXCOORD_0") else { continue };
+            let pos = p.positions();
+            let nrm = match p.attr("NORMAL") {
+                Some(n) => n.to_f32(),
+                None => crate::scene::smooth_normals(pos.as_flattened(), &p.indices).0,
+            };
+            let base = c.positions.len() as u32;
+            c.indices.extend(p.indices.iter().map(|&i| i + base));
+            c.positions.extend(pos);
+            c.normals.extend(nrm);
+            c.uvs.extend(uv.to_f32::<2>());
+        }
+        if c.indices.is_empty() {
+            return Err(crate::error::Error::input(path, "no triangle primitive with TEXCOORD_0 to benchmark"));
+        }
+        Ok(c)
     }
     pub fn mesh(&self) -> TriMesh<'_> {
         TriMesh { positions: &self.positions, normals: &self.normals, uvs: &self.uvs, indices: &self.indices }
@@ -115,7 +146,7 @@ fn eval(s: Surface, u: f32, v: f32) -> ([f32; 3], [f32; 3], [f32; 3]) {
             let pv = [-TAU * r * st * cp, -TAU * r * st * sp, TAU * r * ct];
             (p, pu, pv)
         }
-        Surface::WavyGrid | Surface::Fan => {
+        Surface::WavyGrid | Surface::Fan | Surface::Mesh => {
             let (a, k) = (0.05f32, 3.0 * TAU);
             let z = a * (k * u).sin() * (k * v).sin();
             let pu = [1.0, 0.0, a * k * (k * u).cos() * (k * v).sin()];
@@ -149,6 +180,7 @@ pub fn build(surface: Surface, triangles: usize) -> Case {
         uvs: Vec::new(),
         indices: Vec::with_capacity(nu * nv * 6),
         exact: Vec::new(),
+        label: surface.name().into(),
     };
     for j in 0..=nv {
         for i in 0..=nu {
@@ -182,6 +214,7 @@ fn fan(n: usize) -> Case {
         uvs: vec![[0.5, 0.5]],
         indices: Vec::with_capacity(3 * n),
         exact: vec![[1.0, 0.0, 0.0]],
+        label: "fan".into(),
     };
     for i in 0..n {
         let a = i as f32 / n as f32 * TAU;
@@ -234,7 +267,10 @@ fn stats(mut errs: Vec<f64>, sign_errors: usize, missing: usize) -> ErrorStats {
 }
 
 /// Error against the exact frame of each corner's vertex.
-pub fn error_vs_exact(case: &Case, out: &[Option<[f32; 4]>]) -> ErrorStats {
+pub fn error_vs_exact(case: &Case, out: &[Option<[f32; 4]>]) -> Option<ErrorStats> {
+    if case.exact.is_empty() {
+        return None;
+    }
     let mut errs = Vec::with_capacity(out.len());
     let (mut sign, mut missing) = (0, 0);
     for (k, o) in out.iter().enumerate() {
@@ -248,7 +284,7 @@ pub fn error_vs_exact(case: &Case, out: &[Option<[f32; 4]>]) -> ErrorStats {
             None => missing += 1,
         }
     }
-    stats(errs, sign, missing)
+    Some(stats(errs, sign, missing))
 }
 
 /// Error against another engine's output (the reference).
@@ -279,6 +315,8 @@ pub fn error_vs(out: &[Option<[f32; 4]>], reference: &[Option<[f32; 4]>]) -> (Er
 #[derive(Debug, Clone, Serialize)]
 pub struct Row {
     pub surface: Surface,
+    /// The surface's name, or the mesh's file name.
+    pub name: String,
     pub triangles: usize,
     pub engine: &'static str,
     pub runs: usize,
@@ -286,7 +324,8 @@ pub struct Row {
     pub median_ms: f64,
     pub min_ms: f64,
     pub mtriangles_per_s: f64,
-    pub vs_exact: ErrorStats,
+    /// Against the exact tangent (absent for meshes from files).
+    pub vs_exact: Option<ErrorStats>,
     /// Against `bevy_mikktspace` in the same run (absent when it was not run).
     pub vs_reference: Option<ErrorStats>,
     /// Corners bit-identical to the reference (frame and sign, or both without a frame).
@@ -305,6 +344,8 @@ pub struct Options {
     pub runs: usize,
     /// Skip the reference above this many triangles (0: never skip).
     pub reference_max: usize,
+    /// Mesh files, run after the surfaces.
+    pub meshes: Vec<std::path::PathBuf>,
 }
 
 impl Default for Options {
@@ -316,6 +357,7 @@ impl Default for Options {
             engines: vec![Engine::Fast, Engine::Bevy],
             runs: 5,
             reference_max: 0,
+            meshes: Vec::new(),
         }
     }
 }
@@ -355,20 +397,26 @@ pub fn time_engine(case: &Case, engine: Engine, runs: usize) -> (Vec<Option<[f32
     (out, times)
 }
 
-/// Runs the benchmark; `progress` receives one line per finished row.
-pub fn run(opts: &Options, mut progress: impl FnMut(&Row)) -> Report {
-    let mut cases: Vec<(Surface, usize)> = Vec::new();
+/// Runs the benchmark; `progress` receives one line per finished row. Fails only when a mesh
+/// file cannot be read.
+pub fn run(opts: &Options, mut progress: impl FnMut(&Row)) -> crate::error::Result<Report> {
+    let mut cases: Vec<Box<dyn Fn() -> crate::error::Result<Case>>> = Vec::new();
     for &s in &opts.surfaces {
         for &n in &opts.sizes {
-            cases.push((s, n));
+            cases.push(Box::new(move || Ok(build(s, n))));
         }
     }
     if opts.fan_triangles > 0 {
-        cases.push((Surface::Fan, opts.fan_triangles));
+        let n = opts.fan_triangles;
+        cases.push(Box::new(move || Ok(build(Surface::Fan, n))));
+    }
+    for m in &opts.meshes {
+        cases.push(Box::new(move || Case::from_file(m)));
     }
     let mut rows = Vec::new();
-    for (s, n) in cases {
-        let case = build(s, n);
+    for make in cases {
+        let case = make()?;
+        let s = case.surface;
         let tris = case.triangles();
         let with_ref = opts.engines.contains(&Engine::Bevy) && (opts.reference_max == 0 || tris <= opts.reference_max);
         // The reference runs first; its output is what the other engines are compared with.
@@ -396,6 +444,7 @@ pub fn run(opts: &Options, mut progress: impl FnMut(&Row)) -> Report {
             };
             let row = Row {
                 surface: s,
+                name: case.label.clone(),
                 triangles: tris,
                 engine: engine_name(e),
                 runs: opts.runs.max(1),
@@ -411,13 +460,14 @@ pub fn run(opts: &Options, mut progress: impl FnMut(&Row)) -> Report {
             rows.push(row);
         }
     }
-    Report { threads: rayon::current_num_threads(), rows }
+    Ok(Report { threads: rayon::current_num_threads(), rows })
 }
 
 /// A fixed-width text table of the report.
 pub fn table(r: &Report) -> String {
+    let nw = r.rows.iter().map(|x| x.name.len()).max().unwrap_or(0).max(10);
     let mut s = format!(
-        "threads: {}\n{:<10} {:>9} {:<16} {:>10} {:>9} {:>8} {:>9} {:>9} {:>9} {:>6} {:>7} {:>10} {:>9}\n",
+        "threads: {}\n{:<nw$} {:>9} {:<16} {:>10} {:>9} {:>8} {:>9} {:>9} {:>9} {:>6} {:>7} {:>10} {:>9}\n",
         r.threads,
         "surface",
         "triangles",
@@ -439,19 +489,20 @@ pub fn table(r: &Report) -> String {
         let ident = x.identical_to_reference.map_or("-".into(), |v| {
             format!("{:.2}%", 100.0 * v as f64 / (3 * x.triangles).max(1) as f64)
         });
+        let ex = |f: fn(&ErrorStats) -> String| x.vs_exact.as_ref().map_or("-".into(), f);
         s += &format!(
-            "{:<10} {:>9} {:<16} {:>10.2} {:>9.2} {:>8} {:>9.4} {:>9.4} {:>9.4} {:>6} {:>7} {:>10} {:>9}\n",
-            x.surface.name(),
+            "{:<nw$} {:>9} {:<16} {:>10.2} {:>9.2} {:>8} {:>9} {:>9} {:>9} {:>6} {:>7} {:>10} {:>9}\n",
+            x.name,
             x.triangles,
             x.engine,
             x.median_ms,
             x.mtriangles_per_s,
             speed,
-            x.vs_exact.mean_deg,
-            x.vs_exact.p99_deg,
-            x.vs_exact.max_deg,
-            x.vs_exact.sign_errors,
-            x.vs_exact.missing,
+            ex(|e| format!("{:.4}", e.mean_deg)),
+            ex(|e| format!("{:.4}", e.p99_deg)),
+            ex(|e| format!("{:.4}", e.max_deg)),
+            ex(|e| e.sign_errors.to_string()),
+            ex(|e| e.missing.to_string()),
             refmax,
             ident
         );
@@ -465,7 +516,7 @@ pub fn svg(r: &Report) -> String {
     let pts: Vec<(f64, f64, &Row)> = r
         .rows
         .iter()
-        .map(|x| (x.median_ms.max(1e-3), x.vs_exact.p99_deg.max(1e-4), x))
+        .filter_map(|x| Some((x.median_ms.max(1e-3), x.vs_exact.as_ref()?.p99_deg.max(1e-4), x)))
         .collect();
     let lx = |v: f64| v.log10();
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
@@ -530,6 +581,8 @@ pub fn svg(r: &Report) -> String {
             y + 4.0
         ),
         Surface::Fan => format!("<path d=\"M{:.1} {y:.1} h10 M{x:.1} {:.1} v10\" stroke=\"{c}\" stroke-width=\"2\"/>", x - 5.0, y - 5.0),
+        // Meshes have no exact tangent, so no point on this plot.
+        Surface::Mesh => String::new(),
     };
     for &(x, y, row) in &pts {
         s += &marker(row.surface, px(x), py(y), colour(row.engine));
@@ -592,16 +645,32 @@ mod tests {
             runs: 1,
             ..Options::default()
         };
-        let r = run(&opts, |_| {});
+        let r = run(&opts, |_| {}).expect("no files to read");
         assert_eq!(r.rows.len(), 4);
         for row in &r.rows {
             assert_eq!(row.identical_to_reference, Some(3 * row.triangles), "{row:?}");
-            assert_eq!(row.vs_exact.sign_errors, 0);
-            assert_eq!(row.vs_exact.missing, 0);
-            assert!(row.vs_exact.max_deg < 5.0, "{row:?}");
+            let ex = row.vs_exact.as_ref().expect("surfaces have exact tangents");
+            assert_eq!(ex.sign_errors, 0);
+            assert_eq!(ex.missing, 0);
+            assert!(ex.max_deg < 5.0, "{row:?}");
         }
         let svg = svg(&r);
         assert!(svg.starts_with("<svg") && svg.contains("</svg>"));
         assert!(serde_json::to_string(&r).is_ok());
+    }
+
+    #[test]
+    fn real_meshes_are_compared_with_the_reference_only() {
+        let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/spot/spot.obj");
+        let opts = Options { surfaces: vec![], fan_triangles: 0, runs: 1, meshes: vec![spot], ..Options::default() };
+        let r = run(&opts, |_| {}).expect("spot reads");
+        assert_eq!(r.rows.len(), 2);
+        for row in &r.rows {
+            assert_eq!((row.name.as_str(), row.triangles, row.surface), ("spot.obj", 5856, Surface::Mesh));
+            assert!(row.vs_exact.is_none());
+            assert_eq!(row.identical_to_reference, Some(3 * 5856), "{row:?}");
+        }
+        let missing = Options { meshes: vec!["no/such.obj".into()], ..opts };
+        assert!(run(&missing, |_| {}).is_err());
     }
 }

@@ -5,12 +5,14 @@ use bumpbake::tangent::mikk::Engine;
 use bumpbake::Result;
 use std::path::PathBuf;
 
-/// Tangent engines on parametric surfaces with known exact tangents, and a high-valence fan.
+/// Tangent engines on parametric surfaces with known exact tangents, a high-valence fan, and
+/// real meshes.
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
   bumpbake bench tangents
   bumpbake bench tangents --sizes 10k,100k,1m,4m --surfaces wavy-grid --json > scaling.json
-  bumpbake bench tangents --engines fast --fan 20k --sizes 1m --plot tangents.svg")]
+  bumpbake bench tangents --engines fast --fan 20k --sizes 1m --plot tangents.svg
+  bumpbake bench tangents --sizes 10k --fan 0 --mesh fixtures/spot/spot.obj --mesh scan.glb")]
 pub struct BenchTangentsArgs {
     /// Triangle counts per surface (suffixes k and m allowed), comma separated.
     #[arg(long, value_delimiter = ',', default_value = "10k,100k,1m", value_parser = parse_count)]
@@ -39,6 +41,10 @@ pub struct BenchTangentsArgs {
     /// Also write error-versus-time as an SVG plot.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// A real mesh (OBJ, glTF or GLB) to run too, compared with the reference only (it has no
+    /// exact tangent). Repeatable.
+    #[arg(long, value_name = "FILE")]
+    pub mesh: Vec<PathBuf>,
 }
 
 fn parse_count(s: &str) -> std::result::Result<usize, String> {
@@ -80,12 +86,13 @@ pub fn run(a: BenchTangentsArgs) -> Result<u8> {
         engines: a.engines,
         runs: a.runs,
         reference_max: a.reference_max,
+        meshes: a.mesh,
     };
     let go = || {
         tangents::run(&opts, |row| {
             eprintln!(
                 "{:<10} {:>9} {:<16} {:>10.2} ms {:>8.2} Mtri/s",
-                row.surface.name(),
+                row.name,
                 row.triangles,
                 row.engine,
                 row.median_ms,
@@ -100,7 +107,7 @@ pub fn run(a: BenchTangentsArgs) -> Result<u8> {
             .map_err(|e| bumpbake::Error::usage(format!("bench tangents: --threads {n}: {e}")))?
             .install(go),
         None => go(),
-    };
+    }?;
     if let Some(path) = &a.plot {
         bumpbake::output::write_atomic(path, tangents::svg(&report).as_bytes())?;
     }
