@@ -22,7 +22,9 @@ pub fn check(d: &PrimData, max_angle_deg: f64, ex: &mut Explained, s: &mut Subje
     let normals_c: Vec<[f32; 3]> = normals.iter().map(clean3).collect();
     let uvs_c: Vec<[f32; 2]> = uvs.iter().map(|v| if v.iter().all(|x| x.is_finite()) { *v } else { [0.0; 2] }).collect();
     let mesh = TriMesh { positions: &d.positions, normals: &normals_c, uvs: &uvs_c, indices: &d.indices };
-    let reference = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| mikk::generate(&mesh, Engine::Bevy))) {
+    // The fast engine: bit-identical to the reference (held to it by the differential tests),
+    // linear in time and without the reference's recursion, which a high-valence vertex overflows.
+    let reference = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| mikk::generate(&mesh, Engine::Fast))) {
         Ok(r) => r,
         Err(_) => return,
     };
