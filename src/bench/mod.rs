@@ -6,3 +6,4 @@ pub mod normalmap;
 pub mod plot;
 pub mod surfaces;
 pub mod tangents;
+pub mod tangents_plot;

@@ -510,114 +510,7 @@ pub fn table(r: &Report) -> String {
     s
 }
 
-/// Error (p99 against the exact tangent) versus run time, one point per row, log-log axes.
-pub fn svg(r: &Report) -> String {
-    let (w, h, ml, mr, mt, mb) = (760.0, 480.0, 70.0, 170.0, 30.0, 50.0);
-    let pts: Vec<(f64, f64, &Row)> = r
-        .rows
-        .iter()
-        .filter_map(|x| Some((x.median_ms.max(1e-3), x.vs_exact.as_ref()?.p99_deg.max(1e-4), x)))
-        .collect();
-    let lx = |v: f64| v.log10();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y, _) in &pts {
-        x0 = x0.min(lx(x));
-        x1 = x1.max(lx(x));
-        y0 = y0.min(lx(y));
-        y1 = y1.max(lx(y));
-    }
-    if pts.is_empty() {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
-    let (x0, x1, y0, y1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0), y0.floor(), y1.ceil().max(y0.floor() + 1.0));
-    let px = |v: f64| ml + (lx(v) - x0) / (x1 - x0) * (w - ml - mr);
-    let py = |v: f64| h - mb - (lx(v) - y0) / (y1 - y0) * (h - mt - mb);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">\n\
-         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
-         <text x=\"{}\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">Tangent error (p99 vs exact) against run time ({} threads)</text>\n",
-        (w - mr + ml) / 2.0,
-        r.threads
-    );
-    for e in (x0 as i32)..=(x1 as i32) {
-        let x = px(10f64.powi(e));
-        s += &format!(
-            "<line x1=\"{x:.1}\" y1=\"{mt}\" x2=\"{x:.1}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
-            h - mb,
-            h - mb + 15.0,
-            fmt_pow(e, "ms")
-        );
-    }
-    for e in (y0 as i32)..=(y1 as i32) {
-        let y = py(10f64.powi(e));
-        s += &format!(
-            "<line x1=\"{ml}\" y1=\"{y:.1}\" x2=\"{}\" y2=\"{y:.1}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>\n",
-            w - mr,
-            ml - 5.0,
-            y + 4.0,
-            fmt_pow(e, "°")
-        );
-    }
-    s += &format!(
-        "<rect x=\"{ml}\" y=\"{mt}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\"/>\n\
-         <text x=\"{}\" y=\"{}\" text-anchor=\"middle\">median time per call (log)</text>\n\
-         <text transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">p99 angular error, degrees (log)</text>\n",
-        w - ml - mr,
-        h - mt - mb,
-        (w - mr + ml) / 2.0,
-        h - 12.0,
-        (h - mb + mt) / 2.0
-    );
-    let colour = |e: &str| if e == "fast" { "#d62728" } else { "#1f77b4" };
-    let marker = |sf: Surface, x: f64, y: f64, c: &str| match sf {
-        Surface::Sphere => format!("<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"4\" fill=\"{c}\" fill-opacity=\"0.7\"/>"),
-        Surface::Torus => format!("<rect x=\"{:.1}\" y=\"{:.1}\" width=\"8\" height=\"8\" fill=\"{c}\" fill-opacity=\"0.7\"/>", x - 4.0, y - 4.0),
-        Surface::WavyGrid => format!(
-            "<path d=\"M{x:.1} {:.1} L{:.1} {:.1} L{:.1} {:.1} Z\" fill=\"{c}\" fill-opacity=\"0.7\"/>",
-            y - 5.0,
-            x + 5.0,
-            y + 4.0,
-            x - 5.0,
-            y + 4.0
-        ),
-        Surface::Fan => format!("<path d=\"M{:.1} {y:.1} h10 M{x:.1} {:.1} v10\" stroke=\"{c}\" stroke-width=\"2\"/>", x - 5.0, y - 5.0),
-        // Meshes have no exact tangent, so no point on this plot.
-        Surface::Mesh => String::new(),
-    };
-    for &(x, y, row) in &pts {
-        s += &marker(row.surface, px(x), py(y), colour(row.engine));
-        s += "\n";
-    }
-    let lx0 = w - mr + 15.0;
-    let mut ly = mt + 10.0;
-    for e in ["fast", "bevy_mikktspace"] {
-        s += &format!("<rect x=\"{lx0}\" y=\"{:.1}\" width=\"10\" height=\"10\" fill=\"{}\"/><text x=\"{}\" y=\"{:.1}\">{e}</text>\n", ly - 9.0, colour(e), lx0 + 15.0, ly);
-        ly += 18.0;
-    }
-    for sf in [Surface::Sphere, Surface::Torus, Surface::WavyGrid, Surface::Fan] {
-        s += &marker(sf, lx0 + 5.0, ly - 4.0, "#444");
-        s += &format!("<text x=\"{}\" y=\"{ly:.1}\">{}</text>\n", lx0 + 15.0, sf.name());
-        ly += 18.0;
-    }
-    s += "<text x=\"";
-    s += &format!("{lx0}\" y=\"{:.1}\">larger = more triangles</text>\n", ly + 6.0);
-    s += "</svg>\n";
-    s
-}
-
-fn fmt_pow(e: i32, unit: &str) -> String {
-    let v = 10f64.powi(e);
-    if (-3..=4).contains(&e) {
-        format!("{}{unit}", trim(v))
-    } else {
-        format!("1e{e}{unit}")
-    }
-}
-
-fn trim(v: f64) -> String {
-    let s = format!("{v:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
+pub use super::tangents_plot::{scaling_svg, svg};
 
 #[cfg(test)]
 mod tests {
@@ -656,6 +549,10 @@ mod tests {
         }
         let svg = svg(&r);
         assert!(svg.starts_with("<svg") && svg.contains("</svg>"));
+        // One line per surface and engine (the fan is not a size series).
+        let scaling = scaling_svg(&r);
+        assert_eq!(scaling.matches("<polyline").count(), 2, "{scaling}");
+        assert!(scaling.contains("torus fast") && scaling.contains("torus bevy_mikktspace"));
         assert!(serde_json::to_string(&r).is_ok());
     }
 

@@ -41,6 +41,10 @@ pub struct BenchTangentsArgs {
     /// Also write error-versus-time as an SVG plot.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Also write median time against triangle count as an SVG plot (log-log, one line per
+    /// surface and engine).
+    #[arg(long, value_name = "FILE.svg")]
+    pub scaling_plot: Option<PathBuf>,
     /// A real mesh (OBJ, glTF or GLB) to run too, compared with the reference only (it has no
     /// exact tangent). Repeatable.
     #[arg(long, value_name = "FILE")]
@@ -110,6 +114,9 @@ pub fn run(a: BenchTangentsArgs) -> Result<u8> {
     }?;
     if let Some(path) = &a.plot {
         bumpbake::output::write_atomic(path, tangents::svg(&report).as_bytes())?;
+    }
+    if let Some(path) = &a.scaling_plot {
+        bumpbake::output::write_atomic(path, tangents::scaling_svg(&report).as_bytes())?;
     }
     if a.json {
         let s = serde_json::to_string_pretty(&report).map_err(|e| bumpbake::Error::usage(e.to_string()))?;
