@@ -82,3 +82,83 @@ fn invalid_and_empty_inputs_do_not_panic() {
         }
     }
 }
+
+/// The welded classes of a weld result: `k ~ j` iff they share a representative.
+fn classes(w: &[u32]) -> Vec<usize> {
+    let mut first = std::collections::HashMap::new();
+    w.iter().enumerate().map(|(k, &r)| *first.entry(r).or_insert(k)).collect()
+}
+
+/// A grid of `n x n` quads with duplicated seam vertices (equal values, other indices), so that
+/// welding merges corners of different vertex indices.
+fn seamed_grid(n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u32>) {
+    let (mut p, mut nr, mut uv, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..=n {
+            let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+            p.push([u, v, (3.0 * u).sin() * 0.1]);
+            nr.push([0.0, 0.0, 1.0]);
+            uv.push([u, v]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    for j in 0..n {
+        for i in 0..n {
+            // The right half's quads use copies of their left column's vertices.
+            let left = if i == n / 2 {
+                let copy = |v: u32, p: &mut Vec<[f32; 3]>, nr: &mut Vec<[f32; 3]>, uv: &mut Vec<[f32; 2]>| {
+                    p.push(p[v as usize]);
+                    nr.push(nr[v as usize]);
+                    uv.push(uv[v as usize]);
+                    (p.len() - 1) as u32
+                };
+                (copy(id(i, j), &mut p, &mut nr, &mut uv), copy(id(i, j + 1), &mut p, &mut nr, &mut uv))
+            } else {
+                (id(i, j), id(i, j + 1))
+            };
+            idx.extend([left.0, id(i + 1, j), id(i + 1, j + 1), left.0, id(i + 1, j + 1), left.1]);
+        }
+    }
+    (p, nr, uv, idx)
+}
+
+#[test]
+fn the_weld_shortcut_finds_the_replayed_classes_and_is_taken_on_plain_meshes() {
+    let (p, n, uv, idx) = seamed_grid(24);
+    let m = TriMesh { positions: &p, normals: &n, uvs: &uv, indices: &idx };
+    let c = super::Corners { mesh: &m };
+    let tri = super::triangles::Triangles::build(&c);
+    let short = super::shortcut::weld(&c, &tri.order, tri.n_good).expect("a plain grid takes the shortcut");
+    let replayed = super::weld::weld(&c, &tri.order);
+    assert_eq!(classes(&short), classes(&replayed));
+    // Seam copies weld with the originals: fewer classes than vertex indices in use.
+    let distinct: std::collections::HashSet<u32> = replayed.iter().copied().collect();
+    assert_eq!(distinct.len(), 25 * 25);
+    assert!(same(&gen(&m, Engine::Fast), &gen(&m, Engine::Bevy)));
+}
+
+#[test]
+fn the_weld_shortcut_refuses_signed_zeros_nan_and_huge_coordinates() {
+    let (p0, n0, uv0, idx) = seamed_grid(6);
+    let refuses = |p: &[[f32; 3]], n: &[[f32; 3]], uv: &[[f32; 2]]| {
+        let m = TriMesh { positions: p, normals: n, uvs: uv, indices: &idx };
+        let c = super::Corners { mesh: &m };
+        let tri = super::triangles::Triangles::build(&c);
+        let refused = super::shortcut::weld(&c, &tri.order, tri.n_good).is_none();
+        // Whatever route it takes, the output is the reference's.
+        assert!(same(&gen(&m, Engine::Fast), &gen(&m, Engine::Bevy)));
+        refused
+    };
+    assert!(!refuses(&p0, &n0, &uv0));
+    // A seam copy whose normal has -0.0 where the original has +0.0: equal values, other bits.
+    let mut n = n0.clone();
+    let copy = n0.len() - 1;
+    n[copy][0] = -0.0;
+    assert!(refuses(&p0, &n, &uv0));
+    let mut uv = uv0.clone();
+    uv[3][1] = f32::NAN;
+    assert!(refuses(&p0, &n0, &uv));
+    let mut p = p0.clone();
+    p[0][2] = 1e38;
+    assert!(refuses(&p, &n0, &uv0));
+}
