@@ -2,64 +2,98 @@
 
 use super::tangents::{Report, Row, Surface};
 
+/// A log-log plot area: the SVG header, title, decade grid lines, frame and axis labels, and the
+/// mapping from data to pixels.
+struct LogLog {
+    w: f64,
+    h: f64,
+    ml: f64,
+    mr: f64,
+    mt: f64,
+    mb: f64,
+    /// Decades shown: `10^x0 ..= 10^x1` across, `10^y0 ..= 10^y1` up.
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+}
+
+impl LogLog {
+    /// Fits whole decades around `pts` (x, y > 0); `mr` is the room for the legend.
+    fn new(pts: impl Iterator<Item = (f64, f64)>, mr: f64) -> LogLog {
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for (x, y) in pts {
+            (x0, x1, y0, y1) = (x0.min(x.log10()), x1.max(x.log10()), y0.min(y.log10()), y1.max(y.log10()));
+        }
+        if x0 > x1 {
+            (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+        }
+        let (x0, y0) = (x0.floor(), y0.floor());
+        LogLog { w: 760.0, h: 480.0, ml: 70.0, mr, mt: 30.0, mb: 50.0, x0, x1: x1.ceil().max(x0 + 1.0), y0, y1: y1.ceil().max(y0 + 1.0) }
+    }
+    fn px(&self, v: f64) -> f64 {
+        self.ml + (v.log10() - self.x0) / (self.x1 - self.x0) * (self.w - self.ml - self.mr)
+    }
+    fn py(&self, v: f64) -> f64 {
+        self.h - self.mb - (v.log10() - self.y0) / (self.y1 - self.y0) * (self.h - self.mt - self.mb)
+    }
+    /// Everything but the data, legend and closing tag.
+    fn start(&self, title: &str, (x_unit, x_label): (&str, &str), (y_unit, y_label): (&str, &str)) -> String {
+        let LogLog { w, h, ml, mr, mt, mb, .. } = *self;
+        let mut s = format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">\n\
+             <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
+             <text x=\"{}\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">{title}</text>\n",
+            (w - mr + ml) / 2.0
+        );
+        for e in (self.x0 as i32)..=(self.x1 as i32) {
+            let x = self.px(10f64.powi(e));
+            s += &format!(
+                "<line x1=\"{x:.1}\" y1=\"{mt}\" x2=\"{x:.1}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
+                h - mb,
+                h - mb + 15.0,
+                fmt_pow(e, x_unit)
+            );
+        }
+        for e in (self.y0 as i32)..=(self.y1 as i32) {
+            let y = self.py(10f64.powi(e));
+            s += &format!(
+                "<line x1=\"{ml}\" y1=\"{y:.1}\" x2=\"{}\" y2=\"{y:.1}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>\n",
+                w - mr,
+                ml - 5.0,
+                y + 4.0,
+                fmt_pow(e, y_unit)
+            );
+        }
+        s += &format!(
+            "<rect x=\"{ml}\" y=\"{mt}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\"/>\n\
+             <text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n\
+             <text transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">{y_label}</text>\n",
+            w - ml - mr,
+            h - mt - mb,
+            (w - mr + ml) / 2.0,
+            h - 12.0,
+            (h - mb + mt) / 2.0
+        );
+        s
+    }
+}
+
 /// Error (p99 against the exact tangent) versus run time, one point per row, log-log axes.
 pub fn svg(r: &Report) -> String {
-    let (w, h, ml, mr, mt, mb) = (760.0, 480.0, 70.0, 170.0, 30.0, 50.0);
     let pts: Vec<(f64, f64, &Row)> = r
         .rows
         .iter()
         .filter_map(|x| Some((x.median_ms.max(1e-3), x.vs_exact.as_ref()?.p99_deg.max(1e-4), x)))
         .collect();
-    let lx = |v: f64| v.log10();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y, _) in &pts {
-        x0 = x0.min(lx(x));
-        x1 = x1.max(lx(x));
-        y0 = y0.min(lx(y));
-        y1 = y1.max(lx(y));
-    }
-    if pts.is_empty() {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
-    let (x0, x1, y0, y1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0), y0.floor(), y1.ceil().max(y0.floor() + 1.0));
-    let px = |v: f64| ml + (lx(v) - x0) / (x1 - x0) * (w - ml - mr);
-    let py = |v: f64| h - mb - (lx(v) - y0) / (y1 - y0) * (h - mt - mb);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">\n\
-         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
-         <text x=\"{}\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">Tangent error (p99 vs exact) against run time ({} threads)</text>\n",
-        (w - mr + ml) / 2.0,
-        r.threads
+    let f = LogLog::new(pts.iter().map(|&(x, y, _)| (x, y)), 170.0);
+    let (px, py) = (|v| f.px(v), |v| f.py(v));
+    let mut s = f.start(
+        &format!("Tangent error (p99 vs exact) against run time ({} threads)", r.threads),
+        ("ms", "median time per call (log)"),
+        ("°", "p99 angular error, degrees (log)"),
     );
-    for e in (x0 as i32)..=(x1 as i32) {
-        let x = px(10f64.powi(e));
-        s += &format!(
-            "<line x1=\"{x:.1}\" y1=\"{mt}\" x2=\"{x:.1}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
-            h - mb,
-            h - mb + 15.0,
-            fmt_pow(e, "ms")
-        );
-    }
-    for e in (y0 as i32)..=(y1 as i32) {
-        let y = py(10f64.powi(e));
-        s += &format!(
-            "<line x1=\"{ml}\" y1=\"{y:.1}\" x2=\"{}\" y2=\"{y:.1}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>\n",
-            w - mr,
-            ml - 5.0,
-            y + 4.0,
-            fmt_pow(e, "°")
-        );
-    }
-    s += &format!(
-        "<rect x=\"{ml}\" y=\"{mt}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\"/>\n\
-         <text x=\"{}\" y=\"{}\" text-anchor=\"middle\">median time per call (log)</text>\n\
-         <text transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">p99 angular error, degrees (log)</text>\n",
-        w - ml - mr,
-        h - mt - mb,
-        (w - mr + ml) / 2.0,
-        h - 12.0,
-        (h - mb + mt) / 2.0
-    );
+    let (w, mr, mt) = (f.w, f.mr, f.mt);
     let colour = |e: &str| if e == "fast" { "#d62728" } else { "#1f77b4" };
     let marker = |sf: Surface, x: f64, y: f64, c: &str| match sf {
         Surface::Sphere => format!("<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"4\" fill=\"{c}\" fill-opacity=\"0.7\"/>"),
@@ -114,55 +148,15 @@ fn trim(v: f64) -> String {
 /// point a case), with a dotted line of slope 1 (time proportional to size) through the fast
 /// engine's largest case for comparison.
 pub fn scaling_svg(r: &Report) -> String {
-    let (w, h, ml, mr, mt, mb) = (760.0, 480.0, 70.0, 190.0, 30.0, 50.0);
     let rows: Vec<&Row> = r.rows.iter().filter(|x| x.surface != Surface::Mesh && x.surface != Surface::Fan).collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for x in &rows {
-        let (tx, ty) = ((x.triangles.max(1) as f64).log10(), x.median_ms.max(1e-3).log10());
-        (x0, x1, y0, y1) = (x0.min(tx), x1.max(tx), y0.min(ty), y1.max(ty));
-    }
-    if rows.is_empty() {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
-    let (x0, x1, y0, y1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0), y0.floor(), y1.ceil().max(y0.floor() + 1.0));
-    let px = |v: f64| ml + (v.log10() - x0) / (x1 - x0) * (w - ml - mr);
-    let py = |v: f64| h - mb - (v.log10() - y0) / (y1 - y0) * (h - mt - mb);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">\n\
-         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
-         <text x=\"{}\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">Tangent stage time against mesh size ({} threads)</text>\n",
-        (w - mr + ml) / 2.0,
-        r.threads
+    let f = LogLog::new(rows.iter().map(|x| (x.triangles.max(1) as f64, x.median_ms.max(1e-3))), 190.0);
+    let (px, py) = (|v| f.px(v), |v| f.py(v));
+    let mut s = f.start(
+        &format!("Tangent stage time against mesh size ({} threads)", r.threads),
+        ("", "triangles (log)"),
+        (" ms", "median time per call (log)"),
     );
-    for e in (x0 as i32)..=(x1 as i32) {
-        let x = px(10f64.powi(e));
-        s += &format!(
-            "<line x1=\"{x:.1}\" y1=\"{mt}\" x2=\"{x:.1}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
-            h - mb,
-            h - mb + 15.0,
-            fmt_pow(e, "")
-        );
-    }
-    for e in (y0 as i32)..=(y1 as i32) {
-        let y = py(10f64.powi(e));
-        s += &format!(
-            "<line x1=\"{ml}\" y1=\"{y:.1}\" x2=\"{}\" y2=\"{y:.1}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>\n",
-            w - mr,
-            ml - 5.0,
-            y + 4.0,
-            fmt_pow(e, " ms")
-        );
-    }
-    s += &format!(
-        "<rect x=\"{ml}\" y=\"{mt}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\"/>\n\
-         <text x=\"{}\" y=\"{}\" text-anchor=\"middle\">triangles (log)</text>\n\
-         <text transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">median time per call (log)</text>\n",
-        w - ml - mr,
-        h - mt - mb,
-        (w - mr + ml) / 2.0,
-        h - 12.0,
-        (h - mb + mt) / 2.0
-    );
+    let (w, mr, mt, x0, y0) = (f.w, f.mr, f.mt, f.x0, f.y0);
     let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     for x in &rows {
         let key = format!("{} {}", x.surface.name(), x.engine);
