@@ -101,39 +101,54 @@ pub fn generate_timed(
     let mut grp = timings.time("groups", || groups::build(w, &nb, &mut tri));
     crate::report::mem_mark("engine groups");
     drop(nb);
-    // Sums are made and scattered to corners a slice of groups at a time, so that only a slice
-    // of them is ever held beside the output.
-    // Zeroed in parallel: the first touch of each page (a page fault) is shared between threads.
-    let mut out: Vec<[f32; 4]> = (0..mesh.indices.len()).into_par_iter().with_min_len(1 << 14).map(|_| [0.0; 4]).collect();
-    let (mut t_acc, mut t_out) = (0.0, 0.0);
+    // Sums are made a slice of groups at a time and kept compactly: one value for a group whose
+    // members all got the same bits (the usual case), else one per member. Only then are the
+    // per-triangle and welding arrays dropped and the per-corner output allocated, so the two
+    // never coexist.
+    let t_acc = std::time::Instant::now();
     let n_groups = grp.rep.len();
+    let mut first_slot: Vec<u32> = Vec::with_capacity(n_groups);
+    let mut uniform: Vec<bool> = Vec::with_capacity(n_groups);
+    let mut slots: Vec<V3> = Vec::with_capacity(n_groups);
     let mut g0 = 0;
     while g0 < n_groups {
         let limit = grp.start[g0] as usize + PASS;
         let g1 = (g0 + 1).max(grp.start.partition_point(|&x| (x as usize) <= limit) - 1).min(n_groups);
-        let t0 = std::time::Instant::now();
         let vals = accumulate_all(&c, w, &tri, &mut grp, g0..g1);
-        let t1 = std::time::Instant::now();
         let base = grp.start[g0] as usize;
         for g in g0..g1 {
-            let sign = if grp.orient[g] { 1.0 } else { -1.0 };
-            let range = grp.start[g] as usize..grp.start[g + 1] as usize;
-            for (&k, v) in grp.members[range.clone()].iter().zip(&vals[range.start - base..range.end - base]) {
-                let corner = 3 * tri.order[(k / 3) as usize] as usize + (k % 3) as usize;
-                out[corner] = [v[0], v[1], v[2], sign];
+            let v = &vals[grp.start[g] as usize - base..grp.start[g + 1] as usize - base];
+            let same = v.iter().all(|x| x.map(f32::to_bits) == v[0].map(f32::to_bits));
+            first_slot.push(slots.len() as u32);
+            uniform.push(same);
+            if same {
+                slots.push(v[0]);
+            } else {
+                slots.extend_from_slice(v);
             }
         }
-        t_acc += (t1 - t0).as_secs_f64() * 1e3;
-        t_out += t1.elapsed().as_secs_f64() * 1e3;
         g0 = g1;
     }
+    timings.stages.push(("accumulate".into(), t_acc.elapsed().as_secs_f64() * 1e3));
     crate::report::mem_mark("engine accumulate");
-    timings.stages.push(("accumulate".into(), t_acc));
-    let t_deg = std::time::Instant::now();
-    if ng < tri.order.len() {
+    let t_out = std::time::Instant::now();
+    (tri.s, tri.t, tri.gwa, grp.rep) = Default::default();
+    let welded = (ng < tri.order.len()).then_some(welded);
+    // Zeroed in parallel: the first touch of each page (a page fault) is shared between threads.
+    let mut out: Vec<[f32; 4]> = (0..mesh.indices.len()).into_par_iter().with_min_len(1 << 14).map(|_| [0.0; 4]).collect();
+    for g in 0..n_groups {
+        let sign = if grp.orient[g] { 1.0 } else { -1.0 };
+        let range = grp.start[g] as usize..grp.start[g + 1] as usize;
+        for (i, &k) in grp.members[range].iter().enumerate() {
+            let v = slots[first_slot[g] as usize + if uniform[g] { 0 } else { i }];
+            let corner = 3 * tri.order[(k / 3) as usize] as usize + (k % 3) as usize;
+            out[corner] = [v[0], v[1], v[2], sign];
+        }
+    }
+    if let Some(welded) = welded {
         degenerate(&welded, &tri, n_faces, &mut out);
     }
-    timings.stages.push(("output".into(), t_out + t_deg.elapsed().as_secs_f64() * 1e3));
+    timings.stages.push(("output".into(), t_out.elapsed().as_secs_f64() * 1e3));
     Ok(out)
 }
 
