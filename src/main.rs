@@ -7,6 +7,7 @@ use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    return_large_blocks_to_the_system();
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(code) => ExitCode::from(code),
@@ -16,3 +17,21 @@ fn main() -> ExitCode {
         }
     }
 }
+
+/// glibc serves allocations under its mmap threshold from heaps it keeps after they are freed,
+/// and raises that threshold (up to 32 MB) each time a large block is freed. A mesh's
+/// per-corner arrays are a few MB to tens of MB each and live one stage at a time, so with the
+/// default they pile up as resident memory nobody uses: the 1M-triangle `tangents` run peaked at
+/// 197 MB resident for 138 MB of live heap. A fixed 8 MB threshold maps every such array on its
+/// own and unmaps it when it is freed: 150 MB, for about 0.05-0.1 s more (fresh pages are zeroed
+/// by the kernel instead of reused).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn return_large_blocks_to_the_system() {
+    // SAFETY: mallopt only sets an allocator parameter; it is called before any thread exists.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 8 << 20);
+    }
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn return_large_blocks_to_the_system() {}

@@ -94,7 +94,7 @@ pub(crate) fn weld(c: &Corners, order: &[u32], n_good: usize) -> Option<Vec<u32>
         let exact = super::weld::welded_of(c, order, &ends);
         let i0: Vec<u32> = exact.chunks(2).map(|e| e[0].min(e[1])).collect();
         let largest = i0.iter().copied().max().unwrap_or(0);
-            if i0.iter().filter(|&&x| x == largest).count() >= 3 {
+        if i0.iter().filter(|&&x| x == largest).count() >= 3 {
             return None;
         }
     }
