@@ -57,7 +57,6 @@ impl Mesh {
 }
 
 struct Outcome {
-    out: PathBuf,
     report: Value,
     tangents: Vec<[f32; 4]>,
     normals: Vec<[f32; 3]>,
@@ -98,7 +97,7 @@ fn bake(name: &str, mesh: &Mesh, limit: Duration) -> Outcome {
         fb["undefined"].as_u64().unwrap() + fb["invalid"].as_u64().unwrap(),
         "{name}: the total is the sum of its reasons"
     );
-    Outcome { out, report, tangents, normals, positions }
+    Outcome { report, tangents, normals, positions }
 }
 
 fn fallbacks(o: &Outcome) -> (u64, u64) {
