@@ -122,18 +122,18 @@ pub fn repair(frames: &mut [[f32; 4]], at: CornerNormals) -> FallbackCounts {
     if bad.is_empty() {
         return counts;
     }
+    let mut bad_flag = vec![false; frames.len()];
+    bad.iter().for_each(|&c| bad_flag[c] = true);
     // First valid corner of each vertex, to lend from across triangles.
     let n_vertices = at.vertex.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
     let mut by_vertex = vec![usize::MAX; n_vertices];
     for c in 0..frames.len() {
         let v = at.vertex[c] as usize;
-        if by_vertex[v] == usize::MAX && ok(frames, c) {
+        if by_vertex[v] == usize::MAX && !bad_flag[c] {
             by_vertex[v] = c;
         }
     }
     // Only valid corners lend and only invalid ones change, so the order of repairs is free.
-    let mut bad_flag = vec![false; frames.len()];
-    bad.iter().for_each(|&c| bad_flag[c] = true);
     for &c in &bad {
         let original = frames[c];
         let defined = original[3] != 0.0;

@@ -96,10 +96,9 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
     } else {
         Vec::new()
     };
-    let flat_normals: &[[f32; 3]] = if generated_normals { &normals } else { &[] };
     let mut extra = Vec::new();
     if generated_normals {
-        extra.push(CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: flat_normals.as_flattened() });
+        extra.push(CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: normals.as_flattened() });
     }
     extra.push(CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: frames.as_flattened() });
     if opts.bitangents {

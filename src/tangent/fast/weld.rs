@@ -89,21 +89,21 @@ struct Buckets {
 }
 
 impl Buckets {
-    /// `None` for an empty list.
-    fn new(pos: &[V3]) -> Option<Buckets> {
-        // Bounding box in fixed chunks (same value as the reference's sequential fold; the
-        // chunking does not depend on the thread count).
-        let bbox = pos
-            .par_chunks(CHUNK)
+    /// The split for the `n` list entries whose positions `pos_of` gives; `None` for an empty
+    /// list. The bounding box is folded in fixed chunks (same value as the reference's
+    /// sequential fold; the chunking does not depend on the thread count).
+    fn new(n: usize, pos_of: impl Fn(usize) -> V3 + Sync) -> Option<Buckets> {
+        let bbox = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
             .map(|ch| {
                 let mut b = EMPTY;
-                ch.iter().for_each(|&p| b.grow(p));
+                (ch * CHUNK..n.min((ch + 1) * CHUNK)).for_each(|k| b.grow(pos_of(k)));
                 b
             })
             .collect::<Vec<_>>()
             .into_iter()
             .fold(EMPTY, BBox::union);
-        Self::from_bbox(bbox, pos.len())
+        Self::from_bbox(bbox, n)
     }
     /// The split for a list of `n` entries with bounding box `bbox`.
     fn from_bbox(bbox: BBox, n: usize) -> Option<Buckets> {
@@ -133,17 +133,7 @@ pub(crate) fn welded_of(c: &Corners, order: &[u32], ks: &[usize]) -> Vec<u32> {
     let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
     let pos_of = |k: usize| c.pos(id_of(k) as usize);
     let n = order.len() * 3;
-    let bbox = (0..n.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|ch| {
-            let mut b = EMPTY;
-            (ch * CHUNK..n.min((ch + 1) * CHUNK)).for_each(|k| b.grow(pos_of(k)));
-            b
-        })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .fold(EMPTY, BBox::union);
-    let Some(bk) = Buckets::from_bbox(bbox, n) else { return Vec::new() };
+    let Some(bk) = Buckets::new(n, pos_of) else { return Vec::new() };
     let mut wanted = vec![false; GROUPS];
     ks.iter().for_each(|&k| wanted[bk.of(&pos_of(k))] = true);
     // Each wanted bucket's entries in list order (the reference's stable bucket sort).
@@ -185,7 +175,7 @@ pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
     let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
     let pos = list_positions(c, order);
     let mut welded: Vec<u32> = (0..n).into_par_iter().with_min_len(1 << 12).map(id_of).collect();
-    let Some(bk) = Buckets::new(&pos) else { return welded };
+    let Some(bk) = Buckets::new(pos.len(), |k| pos[k]) else { return welded };
     let bucket_of = |p: &V3| bk.of(p);
     // Stable counting sort by bucket (the reference's `sort_by_key`), in parallel: each chunk of
     // the list sorts itself by bucket, then each bucket concatenates its segments chunk by chunk.
