@@ -3,7 +3,7 @@
 //!   for arbitrary finite meshes (degenerate, tiny, huge, repeated indices, any normals);
 //! - split/merge (`weld`/`unweld`) keeps every corner's attributes.
 
-use bumpbake::scene::weld::{split_corners, unweld, weld, CornerStream};
+use bumpbake::scene::weld::{split_corners, unweld, weld, CornerStream, CornerValues};
 use bumpbake::scene::{Primitive, Stream};
 use bumpbake::tangent::{primitive_with_stats, Options};
 use glam::Vec3;
@@ -54,7 +54,7 @@ proptest! {
         }
         attributes.push(("TEXCOORD_0".to_string(), Stream::from_f32("VEC2", &uv)));
         let p = Primitive { attributes, targets: vec![], indices: idx.clone(), mode: 4 };
-        let (out, stats) = primitive_with_stats(&p, 0, v_up, &Options::default());
+        let (out, stats) = primitive_with_stats(p, 0, v_up, &Options::default());
         prop_assert_eq!(out.indices.len(), idx.len());
         prop_assert!(stats.fallback.total() <= idx.len());
         let t: Vec<[f32; 4]> = out.attr("TANGENT").unwrap().to_f32();
@@ -112,8 +112,8 @@ proptest! {
         all.insert(1, ("NORMAL".into(), Stream::from_f32("VEC3", &nrm)));
         all.push(("TANGENT".into(), Stream::from_f32("VEC4", &tan)));
         let split = split_corners(&p, &[], &[
-            CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: nrm.as_flattened() },
-            CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: tan.as_flattened() },
+            CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: CornerValues::Flat(nrm.as_flattened()) },
+            CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: CornerValues::Flat(tan.as_flattened()) },
         ]);
         prop_assert_eq!(&split, &weld(all, targets.clone(), 4));
         // Merged: no two output vertices are equal in every attribute.

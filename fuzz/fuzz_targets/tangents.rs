@@ -51,7 +51,7 @@ fuzz_target!(|m: Mesh| {
     }
     attributes.push(("TEXCOORD_0".to_string(), Stream::from_f32("VEC2", &uv)));
     let p = Primitive { attributes, targets: vec![], indices: idx.clone(), mode: 4 };
-    let (out, stats) = primitive_with_stats(&p, 0, m.v_up, &Options { bitangents: true, ..Default::default() });
+    let (out, stats) = primitive_with_stats(p, 0, m.v_up, &Options { bitangents: true, ..Default::default() });
     assert_eq!(stats.triangles, idx.len() / 3);
     assert_eq!(out.indices.len(), idx.len());
     let t: Vec<[f32; 4]> = out.attr("TANGENT").expect("tangents").to_f32();

@@ -122,109 +122,160 @@ pub(crate) fn hash_words(words: impl IntoIterator<Item = u32>) -> u64 {
 }
 
 /// A stream with one `f32` vector per corner, to be added to a primitive by [`split_corners`].
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct CornerStream<'a> {
     /// Where the stream goes among the attributes (`usize::MAX` appends).
     pub at: usize,
     pub name: &'a str,
     /// `VEC2`, `VEC3` or `VEC4`.
     pub ty: &'a str,
+    pub values: CornerValues<'a>,
+}
+
+/// Where a [`CornerStream`]'s values come from.
+#[derive(Clone, Copy)]
+pub enum CornerValues<'a> {
     /// The components, corner after corner.
-    pub values: &'a [f32],
+    Flat(&'a [f32]),
+    /// Corner -> value (components past the stream's width are ignored): for values kept
+    /// compactly or cheap to recompute, never stored per corner.
+    Fn(&'a (dyn Fn(usize) -> [f32; 4] + Sync)),
 }
 
 impl CornerStream<'_> {
     fn width(&self) -> usize {
         super::accessor::component_count(self.ty).unwrap_or(1)
     }
-    fn get(&self, c: usize) -> &[f32] {
-        let n = self.width();
-        &self.values[c * n..(c + 1) * n]
+    #[inline]
+    fn get(&self, c: usize) -> [f32; 4] {
+        match self.values {
+            CornerValues::Flat(v) => {
+                let n = self.width();
+                let mut out = [0.0; 4];
+                out[..n].copy_from_slice(&v[c * n..(c + 1) * n]);
+                out
+            }
+            CornerValues::Fn(f) => f(c),
+        }
     }
 }
 
 /// Re-indexes an indexed primitive to which per-corner streams are being added (tangents, flat
 /// normals). The result is exactly [`weld`] of the unwelded primitive plus those streams, without
-/// unwelding, leaving out the attributes named in `leave_out`: byte-identical vertices are found once (by hashing vertices, not corners), and a
-/// corner then only compares its new values (bit for bit) with the vertices already made from its
-/// vertex's class.
+/// unwelding, leaving out the attributes named in `leave_out`. See [`SplitPlan`], which does the
+/// same without copying the primitive.
 pub fn split_corners(base: &Primitive, leave_out: &[&str], extra: &[CornerStream]) -> Primitive {
-    use rayon::prelude::*;
-    let corners = base.indices.len();
-    let kept: Vec<&(String, Stream)> = base.attributes.iter().filter(|(n, _)| !leave_out.contains(&n.as_str())).collect();
-    let vertex_streams: Vec<&Stream> = kept.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
-    let n_vertices = base.vertex_count().max(base.indices.iter().map(|&v| v as usize + 1).max().unwrap_or(0));
-    let mut used = vec![false; n_vertices];
-    for &v in &base.indices {
-        used[v as usize] = true;
-    }
-    let hashes: Vec<u64> = (0..n_vertices)
-        .into_par_iter()
-        .with_min_len(1 << 14)
-        .map(|v| {
-            if !used[v] {
-                return 0;
-            }
-            let mut h = Fx::default();
-            for s in &vertex_streams {
-                h.write(s.elem(v));
-            }
-            h.0 | 1
-        })
-        .collect();
-    drop(used);
-    // The class of each vertex: the first byte-identical vertex.
-    let class = first_equal(&hashes, |a, b| vertex_streams.iter().all(|s| s.elem(a) == s.elem(b)));
-    drop(hashes);
-    let same = |a: usize, b: usize| extra.iter().all(|s| s.get(a).iter().zip(s.get(b)).all(|(x, y)| x.to_bits() == y.to_bits()));
-    let mut made_first = vec![u32::MAX; n_vertices];
-    let mut made_more: HashMap<u32, Vec<u32>, BuildHasherDefault<Fx>> = HashMap::default();
-    let mut order: Vec<u32> = Vec::new();
-    let mut indices = Vec::with_capacity(corners);
-    for c in 0..corners {
-        let v = class[base.indices[c] as usize];
-        let first = made_first[v as usize];
-        let m = if first == u32::MAX {
-            made_first[v as usize] = order.len() as u32;
-            order.push(c as u32);
-            order.len() as u32 - 1
-        } else if same(order[first as usize] as usize, c) {
-            first
-        } else {
-            let more = made_more.entry(v).or_default();
-            match more.iter().copied().find(|&m| same(order[m as usize] as usize, c)) {
-                Some(m) => m,
-                None => {
-                    more.push(order.len() as u32);
-                    order.push(c as u32);
-                    order.len() as u32 - 1
+    SplitPlan::new(base, leave_out, extra).apply(base.clone())
+}
+
+/// The new vertices and indices of [`split_corners`], with the added streams already made; then
+/// [`SplitPlan::apply`] moves the primitive's own streams over one at a time. Two steps, so that
+/// whatever the added streams are read from (per-corner frames) can be freed before the
+/// primitive's streams are gathered.
+pub struct SplitPlan {
+    indices: Vec<u32>,
+    /// Source vertex of each new vertex.
+    origins: Vec<u32>,
+    leave_out: Vec<String>,
+    extra: Vec<(usize, String, Stream)>,
+}
+
+impl SplitPlan {
+    /// Byte-identical vertices are found once (by hashing vertices, not corners), and a corner
+    /// then only compares its new values (bit for bit) with the vertices already made from its
+    /// vertex's class.
+    pub fn new(base: &Primitive, leave_out: &[&str], extra: &[CornerStream]) -> SplitPlan {
+        use rayon::prelude::*;
+        let corners = base.indices.len();
+        let kept: Vec<&(String, Stream)> = base.attributes.iter().filter(|(n, _)| !leave_out.contains(&n.as_str())).collect();
+        let vertex_streams: Vec<&Stream> = kept.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
+        let n_vertices = base.vertex_count().max(base.indices.iter().map(|&v| v as usize + 1).max().unwrap_or(0));
+        let mut used = vec![false; n_vertices];
+        for &v in &base.indices {
+            used[v as usize] = true;
+        }
+        let hashes: Vec<u64> = (0..n_vertices)
+            .into_par_iter()
+            .with_min_len(1 << 14)
+            .map(|v| {
+                if !used[v] {
+                    return 0;
                 }
-            }
-        };
-        indices.push(m);
+                let mut h = Fx::default();
+                for s in &vertex_streams {
+                    h.write(s.elem(v));
+                }
+                h.0 | 1
+            })
+            .collect();
+        drop(used);
+        // The class of each vertex: the first byte-identical vertex.
+        let class = first_equal(&hashes, |a, b| vertex_streams.iter().all(|s| s.elem(a) == s.elem(b)));
+        drop(hashes);
+        let same = |a: usize, b: usize| extra.iter().all(|s| s.get(a)[..s.width()].iter().zip(&s.get(b)).all(|(x, y)| x.to_bits() == y.to_bits()));
+        let mut made_first = vec![u32::MAX; n_vertices];
+        let mut made_more: HashMap<u32, Vec<u32>, BuildHasherDefault<Fx>> = HashMap::default();
+        let mut order: Vec<u32> = Vec::new();
+        let mut indices = Vec::with_capacity(corners);
+        for c in 0..corners {
+            let v = class[base.indices[c] as usize];
+            let first = made_first[v as usize];
+            let m = if first == u32::MAX {
+                made_first[v as usize] = order.len() as u32;
+                order.push(c as u32);
+                order.len() as u32 - 1
+            } else if same(order[first as usize] as usize, c) {
+                first
+            } else {
+                let more = made_more.entry(v).or_default();
+                match more.iter().copied().find(|&m| same(order[m as usize] as usize, c)) {
+                    Some(m) => m,
+                    None => {
+                        more.push(order.len() as u32);
+                        order.push(c as u32);
+                        order.len() as u32 - 1
+                    }
+                }
+            };
+            indices.push(m);
+        }
+        drop((made_first, made_more, class));
+        let extra = extra
+            .iter()
+            .map(|s| {
+                let mut data = Vec::with_capacity(order.len() * s.width() * 4);
+                for &c in &order {
+                    for x in &s.get(c as usize)[..s.width()] {
+                        data.extend_from_slice(&x.to_le_bytes());
+                    }
+                }
+                (s.at, s.name.to_string(), Stream { format: super::accessor::Format::f32(s.ty), data, template: None })
+            })
+            .collect();
+        let origins = order.iter().map(|&c| base.indices[c as usize]).collect();
+        SplitPlan { indices, origins, leave_out: leave_out.iter().map(|s| s.to_string()).collect(), extra }
     }
-    drop((made_first, made_more, class));
-    let origins: Vec<u32> = order.iter().map(|&c| base.indices[c as usize]).collect();
-    let mut attributes: Vec<(String, Stream)> = kept.iter().map(|(n, s)| (n.clone(), s.gather(&origins))).collect();
-    for s in extra {
-        let mut data = Vec::with_capacity(order.len() * s.width() * 4);
-        for &c in &order {
-            for x in s.get(c as usize) {
-                data.extend_from_slice(&x.to_le_bytes());
+
+    /// Number of vertices the primitive will have.
+    pub fn vertex_count(&self) -> usize {
+        self.origins.len()
+    }
+
+    /// The re-indexed primitive. Each of `base`'s streams is freed as soon as it is gathered.
+    pub fn apply(self, base: Primitive) -> Primitive {
+        let Primitive { attributes, targets, indices, mode } = base;
+        drop(indices);
+        let origins = &self.origins;
+        let gather = |list: Vec<(String, Stream)>| list.into_iter().map(|(n, s)| (n, s.gather(origins))).collect::<Vec<_>>();
+        let mut attributes = gather(attributes.into_iter().filter(|(n, _)| !self.leave_out.contains(n)).collect());
+        for (at, name, stream) in self.extra {
+            if at < attributes.len() {
+                attributes.insert(at, (name, stream));
+            } else {
+                attributes.push((name, stream));
             }
         }
-        let stream = Stream { format: super::accessor::Format::f32(s.ty), data, template: None };
-        if s.at < attributes.len() {
-            attributes.insert(s.at, (s.name.to_string(), stream));
-        } else {
-            attributes.push((s.name.to_string(), stream));
-        }
-    }
-    Primitive {
-        attributes,
-        targets: base.targets.iter().map(|t| t.iter().map(|(n, s)| (n.clone(), s.gather(&origins))).collect()).collect(),
-        indices,
-        mode: base.mode,
+        Primitive { attributes, targets: targets.into_iter().map(gather).collect(), indices: self.indices, mode }
     }
 }
 
@@ -256,7 +307,7 @@ mod tests {
         let uv = Stream::from_f32("VEC2", &[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0]]);
         let p = Primitive { attributes: vec![("TEXCOORD_0".into(), uv)], targets: vec![], indices: vec![0, 1, 2, 0], mode: 4 };
         let t = [[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, -1.0f32]];
-        let out = split_corners(&p, &[], &[CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: t.as_flattened() }]);
+        let out = split_corners(&p, &[], &[CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: CornerValues::Flat(t.as_flattened()) }]);
         assert_eq!(out.indices, vec![0, 1, 1, 2]);
         assert_eq!(out.attr("TANGENT").unwrap().to_f32::<4>()[2], [-1.0, 0.0, 0.0, -1.0]);
         assert_eq!(out.attributes.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["TEXCOORD_0", "TANGENT"]);

@@ -18,6 +18,7 @@
 //! The only absolute tolerances are those for frames that are already meant to be unit
 //! ([`UNIT_TOLERANCE`], [`ORTHO_TOLERANCE`]).
 
+use super::frames::Frames;
 use glam::Vec3;
 
 /// Tolerances a frame must meet to leave the tool unchanged.
@@ -110,15 +111,15 @@ pub struct CornerNormals<'a> {
     pub vertex: &'a [u32],
 }
 
-/// Replaces every unusable corner frame, in place. `frames` are per corner (three per triangle),
-/// `w == 0` where the reference gave no frame, otherwise already in the output's `w` convention.
-pub fn repair(frames: &mut [[f32; 4]], at: CornerNormals) -> FallbackCounts {
+/// Replaces every unusable corner frame. `frames` are per corner (three per triangle), already in
+/// the output's `w` convention; a replaced corner gets a value of its own.
+pub fn repair(frames: &mut Frames, at: CornerNormals) -> FallbackCounts {
     use rayon::prelude::*;
     let mut counts = FallbackCounts::default();
     // Unit normals, once per normal rather than once per corner.
     let units: Vec<Option<Vec3>> = at.normals.par_iter().with_min_len(1 << 12).map(|&n| unit(Vec3::from(n))).collect();
-    let ok = |frames: &[[f32; 4]], c: usize| is_valid_unit(frames[c], units[at.normal_of[c] as usize]);
-    let bad: Vec<usize> = (0..frames.len()).into_par_iter().with_min_len(1 << 12).filter(|&c| !ok(frames, c)).collect();
+    let ok = |c: usize| frames.get(c).is_some_and(|t| is_valid_unit(t, units[at.normal_of[c] as usize]));
+    let bad: Vec<usize> = (0..frames.len()).into_par_iter().with_min_len(1 << 12).filter(|&c| !ok(c)).collect();
     if bad.is_empty() {
         return counts;
     }
@@ -134,36 +135,31 @@ pub fn repair(frames: &mut [[f32; 4]], at: CornerNormals) -> FallbackCounts {
         }
     }
     // Only valid corners lend and only invalid ones change, so the order of repairs is free.
+    let mut repaired = Vec::with_capacity(bad.len());
     for &c in &bad {
-        let original = frames[c];
-        let defined = original[3] != 0.0;
-        if defined {
-            counts.invalid += 1;
-        } else {
-            counts.undefined += 1;
+        let original = frames.get(c);
+        match original {
+            Some(_) => counts.invalid += 1,
+            None => counts.undefined += 1,
         }
         let n = Vec3::from(at.normals[at.normal_of[c] as usize]);
         let tri = c / 3 * 3;
         let lenders = (tri..tri + 3).filter(|&k| k != c && !bad_flag[k]).chain(Some(by_vertex[at.vertex[c] as usize]).filter(|&k| k != usize::MAX));
-        let mut chosen = None;
-        for k in lenders {
-            let t = frames[k];
-            if let Some(v) = orthogonalise(Vec3::new(t[0], t[1], t[2]), n) {
-                chosen = Some([v.x, v.y, v.z, t[3]]);
-                break;
-            }
-        }
-        frames[c] = match chosen {
+        let chosen = lenders.filter_map(|k| frames.get(k)).find_map(|t| orthogonalise(Vec3::new(t[0], t[1], t[2]), n).map(|v| [v.x, v.y, v.z, t[3]]));
+        repaired.push(match chosen {
             Some(f) => {
                 counts.borrowed += 1;
                 f
             }
             None => {
-                let w = if defined && original[3] < 0.0 { -1.0 } else { 1.0 };
+                let w = if original.is_some_and(|t| t[3] < 0.0) { -1.0 } else { 1.0 };
                 let v = any_orthogonal(n);
                 [v.x, v.y, v.z, w]
             }
-        };
+        });
+    }
+    for (&c, v) in bad.iter().zip(repaired) {
+        frames.set(c, v);
     }
     counts
 }
@@ -174,11 +170,11 @@ mod tests {
 
     /// `repair` on frames with `None` as `w = 0`, one normal per corner.
     fn fix(f: &[Option<[f32; 4]>], normals: &[Vec3], vertex: &[u32]) -> (Vec<[f32; 4]>, FallbackCounts) {
-        let mut frames: Vec<[f32; 4]> = f.iter().map(|t| t.unwrap_or([0.0; 4])).collect();
+        let mut frames = Frames::from_flat(f.iter().map(|t| t.unwrap_or([0.0; 4])).collect());
         let n: Vec<[f32; 3]> = normals.iter().map(|v| v.to_array()).collect();
         let ids: Vec<u32> = (0..n.len() as u32).collect();
         let c = repair(&mut frames, CornerNormals { normals: &n, normal_of: &ids, vertex });
-        (frames, c)
+        (frames.to_flat(), c)
     }
 
     #[test]

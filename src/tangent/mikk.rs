@@ -1,6 +1,7 @@
-//! The MikkTSpace engine boundary. Everything above this file sees per-corner frames; only this
+//! The MikkTSpace engine boundary. Everything above this file sees per-corner frames ([`Frames`]); only this
 //! file knows which implementation produced them, so a faster one can replace it.
 
+use super::frames::{Frames, NO_FRAME};
 use super::TriMesh;
 
 /// Which implementation computes the reference frames.
@@ -20,10 +21,15 @@ pub fn generate(mesh: &TriMesh, engine: Engine) -> Vec<Option<[f32; 4]>> {
     frames(mesh, engine).into_iter().map(|t| (t[3] != 0.0).then_some(t)).collect()
 }
 
-/// [`generate`] as flat frames, `[0.0; 4]` (`w == 0`) where it gives `None`: a fifth less memory,
-/// and no conversion for the fast engine.
+/// [`generate`] as flat frames, `[0.0; 4]` (`w == 0`) where it gives `None`.
 pub fn frames(mesh: &TriMesh, engine: Engine) -> Vec<[f32; 4]> {
-    let bevy = |mesh: &TriMesh| generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect();
+    compact(mesh, engine).to_flat()
+}
+
+/// [`generate`] as [`Frames`]: each value once per group of corners the engine shares it among
+/// (the fast engine), or once per corner (the reference).
+pub fn compact(mesh: &TriMesh, engine: Engine) -> Frames {
+    let bevy = |mesh: &TriMesh| Frames::from_flat(generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect());
     match engine {
         Engine::Bevy => bevy(mesh),
         Engine::Fast => match super::fast::generate(mesh) {
@@ -31,7 +37,7 @@ pub fn frames(mesh: &TriMesh, engine: Engine) -> Vec<[f32; 4]> {
             // Beyond 32-bit corner ids: the reference has no such limit.
             Err(super::fast::Unsupported::TooLarge) => bevy(mesh),
             // An index past an attribute array: no frame is defined (the reference panics).
-            Err(super::fast::Unsupported::IndexOutOfRange) => vec![[0.0; 4]; mesh.indices.len()],
+            Err(super::fast::Unsupported::IndexOutOfRange) => Frames { slot: vec![NO_FRAME; mesh.indices.len()], values: Vec::new() },
         },
     }
 }

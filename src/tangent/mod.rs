@@ -7,11 +7,11 @@ pub mod apply;
 pub mod command;
 pub mod fallback;
 pub mod fast;
+pub mod frames;
 pub mod mikk;
 
-use crate::scene::weld::{split_corners, CornerStream};
+use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
 use crate::scene::{flat_normals, Primitive};
-use rayon::prelude::*;
 use fallback::FallbackCounts;
 use glam::Vec3;
 
@@ -49,12 +49,27 @@ pub struct FrameStats {
 /// `uv_v_up` says the UVs follow OBJ's convention (v up): the reference sign is kept. For glTF UVs
 /// (v down) they are fed as stored and `w` is the negated reference sign (see the conventions).
 /// The primitive must be a triangle list with that UV set; its old TANGENT is replaced.
-pub fn primitive_with_tangents(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> Primitive {
+pub fn primitive_with_tangents(p: Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> Primitive {
     primitive_with_stats(p, uv_set, uv_v_up, opts).0
 }
 
-/// [`primitive_with_tangents`], with what it did.
-pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
+/// [`primitive_with_tangents`], with what it did. Takes the primitive by value so that each of
+/// its streams can be freed as soon as the output's copy of it is made.
+pub fn primitive_with_stats(p: Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
+    let vertices_in = p.vertex_count();
+    let triangles = p.indices.len() / 3;
+    let generated_normals = p.attr("NORMAL").is_none();
+    let (plan, fallback) = split_plan(&p, uv_set, uv_v_up, opts);
+    let mut out = plan.apply(p);
+    out.mode = 4;
+    crate::report::mem_mark("split");
+    let stats = FrameStats { vertices_in, vertices_out: out.vertex_count(), triangles, generated_normals, fallback };
+    (out, stats)
+}
+
+/// Frames for every corner of `p`, repaired, and the vertices and streams they make: everything
+/// that reads the frames, which are freed on return.
+fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (SplitPlan, FallbackCounts) {
     let uv_name = format!("TEXCOORD_{uv_set}");
     let n_vertices = p.vertex_count();
     // Borrowed from the streams where possible. Without POSITION (callers skip such primitives)
@@ -82,39 +97,28 @@ pub fn primitive_with_stats(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Op
     crate::report::mem_mark("engine");
     if !uv_v_up {
         // glTF UVs run v down: the output's w is the reference's sign negated (see the conventions).
-        frames.par_iter_mut().with_min_len(1 << 12).for_each(|t| t[3] = -t[3]);
+        frames.values.iter_mut().for_each(|t| t[3] = -t[3]);
     }
     let fallback = fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
     crate::report::mem_mark("repair");
 
-    let bitangents: Vec<[f32; 3]> = if opts.bitangents {
-        frames
-            .par_iter()
-            .zip(normal_of.par_iter())
-            .map(|(t, &n)| (Vec3::from(normals[n as usize]).normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3]).to_array())
-            .collect()
-    } else {
-        Vec::new()
+    // Every corner has a frame now. Tangents and bitangents are read through the compact frames,
+    // never spelt out per corner.
+    let tangent = |c: usize| frames.get(c).unwrap_or([0.0; 4]);
+    let bitangent = |c: usize| {
+        let t = tangent(c);
+        let b = Vec3::from(normals[normal_of[c] as usize]).normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3];
+        [b.x, b.y, b.z, 0.0]
     };
     let mut extra = Vec::new();
     if generated_normals {
-        extra.push(CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: normals.as_flattened() });
+        extra.push(CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: CornerValues::Flat(normals.as_flattened()) });
     }
-    extra.push(CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: frames.as_flattened() });
+    extra.push(CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: CornerValues::Fn(&tangent) });
     if opts.bitangents {
-        extra.push(CornerStream { at: usize::MAX, name: "_BITANGENT", ty: "VEC3", values: bitangents.as_flattened() });
+        extra.push(CornerStream { at: usize::MAX, name: "_BITANGENT", ty: "VEC3", values: CornerValues::Fn(&bitangent) });
     }
-    let mut out = split_corners(p, &["TANGENT", "_BITANGENT"], &extra);
-    out.mode = 4;
-    crate::report::mem_mark("split");
-    let stats = FrameStats {
-        vertices_in: p.vertex_count(),
-        vertices_out: out.vertex_count(),
-        triangles: p.indices.len() / 3,
-        generated_normals,
-        fallback,
-    };
-    (out, stats)
+    (SplitPlan::new(p, &["TANGENT", "_BITANGENT"], &extra), fallback)
 }
 
 /// Stack bytes the reference needs per triangle around one vertex, with a wide margin.
@@ -125,9 +129,9 @@ const STACK_PER_TRIANGLE: usize = 1024;
 /// worker stack and abort the process. When the mesh has a vertex position shared by more than
 /// a thousand corners, generation runs on a thread whose stack grows with that count.
 /// Only the `bevy_mikktspace` engine recurses; ours walks groups with an explicit stack.
-fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> Vec<[f32; 4]> {
+fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> frames::Frames {
     if engine != mikk::Engine::Bevy {
-        return mikk::frames(mesh, engine);
+        return mikk::compact(mesh, engine);
     }
     let mut per_position: std::collections::HashMap<[u32; 3], usize> = std::collections::HashMap::new();
     let mut most = 0;
@@ -138,14 +142,14 @@ fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> Vec<[f32; 4]> {
         most = most.max(*n);
     }
     if most <= 1000 {
-        return mikk::frames(mesh, engine);
+        return mikk::compact(mesh, engine);
     }
     let stack = (4 << 20) + most * STACK_PER_TRIANGLE;
     std::thread::scope(|s| {
-        match std::thread::Builder::new().name("mikktspace".into()).stack_size(stack).spawn_scoped(s, || mikk::frames(mesh, engine)) {
+        match std::thread::Builder::new().name("mikktspace".into()).stack_size(stack).spawn_scoped(s, || mikk::compact(mesh, engine)) {
             Ok(h) => h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)),
             // No thread to be had: try on this one.
-            Err(_) => mikk::frames(mesh, engine),
+            Err(_) => mikk::compact(mesh, engine),
         }
     })
 }

@@ -18,8 +18,8 @@
 //! O(size - first excluded position) per distinct exclusion set.
 
 use super::math::{acos, add, dot, normalized_or_zero, project, scale, sub, V3};
-use super::triangles::Triangles;
-use super::Corners;
+use super::triangles;
+use super::{Corners, Welded};
 use std::collections::HashMap;
 
 const THRESHOLD: f32 = -1.0;
@@ -42,10 +42,11 @@ fn compatible(a: &Member, b: &Member) -> bool {
 
 /// Computes the output tangent of every member of one group. `members` are list entries
 /// `3 * t + j`, sorted ascending; `out[i]` receives member `i`'s normalised tangent.
-pub(crate) fn group_tangents(
+pub(crate) fn group_tangents<W: Welded + ?Sized>(
     c: &Corners,
-    w: &[u32],
-    tri: &Triangles,
+    w: &W,
+    order: &[u32],
+    gwa: &[bool],
     rep: u32,
     members: &[u32],
     out: &mut [V3],
@@ -55,16 +56,17 @@ pub(crate) fn group_tangents(
     scratch.clear();
     scratch.extend(members.iter().map(|&k| {
             let (t, j) = ((k / 3) as usize, (k % 3) as usize);
-            let s = project(tri.s[t], n);
-            let tt = project(tri.t[t], n);
-            let gwa = tri.gwa[t];
+            let (s0, t0) = triangles::first_order(c, order[t] as usize);
+            let s = project(s0, n);
+            let tt = project(t0, n);
+            let gwa = gwa[t];
             let cc = if gwa {
                 [0.0; 3]
             } else {
                 let p = [
-                    c.pos(w[3 * t + (j + 1) % 3] as usize),
-                    c.pos(w[3 * t + j] as usize),
-                    c.pos(w[3 * t + (j + 2) % 3] as usize),
+                    c.pos(w.at(3 * t + (j + 1) % 3) as usize),
+                    c.pos(w.at(3 * t + j) as usize),
+                    c.pos(w.at(3 * t + (j + 2) % 3) as usize),
                 ];
                 let v0 = project(sub(p[0], p[1]), n);
                 let v1 = project(sub(p[2], p[1]), n);

@@ -9,35 +9,35 @@
 //! of the first group, in seeding order, that reaches it.
 
 use super::neighbors::NONE;
-use super::triangles::Triangles;
+use super::Welded;
 
 /// Groups as flat arrays (CSR): group `g` owns `members[start[g]..start[g + 1]]`, each member a
-/// list entry `3 * t + j` (good triangle `t`, corner `j` at the group's vertex).
+/// list entry `3 * t + j` (good triangle `t`, corner `j` at the group's vertex); every member's
+/// welded id is the group vertex's.
 pub(crate) struct Groups {
     pub start: Vec<u32>,
     pub members: Vec<u32>,
-    /// Welded id (input corner id) of each group's vertex.
-    pub rep: Vec<u32>,
     pub orient: Vec<bool>,
 }
 
 #[inline]
-fn corner_of(w: &[u32], u: usize, rep: u32) -> Option<usize> {
-    (0..3).find(|&j| w[3 * u + j] == rep)
+fn corner_of<W: Welded + ?Sized>(w: &W, u: usize, rep: u32) -> Option<usize> {
+    (0..3).find(|&j| w.at(3 * u + j) == rep)
 }
 
-pub(crate) fn build(w: &[u32], nb: &[u32], tri: &mut Triangles) -> Groups {
-    let ng = tri.n_good;
+/// `gwa` and `orient` are [`super::triangles::Triangles`]' (`orient` is updated for "group with
+/// anything" triangles).
+pub(crate) fn build<W: Welded + ?Sized>(w: &W, nb: &[u32], gwa: &[bool], orient: &mut [bool]) -> Groups {
+    let ng = gwa.len();
     let mut assigned = vec![false; 3 * ng];
     let mut g = Groups {
         start: vec![0],
         members: Vec::with_capacity(3 * ng),
-        rep: Vec::new(),
         orient: Vec::new(),
     };
     let mut stack: Vec<u32> = Vec::new();
     for t in 0..ng {
-        if tri.gwa[t] {
+        if gwa[t] {
             continue;
         }
         for i in 0..3 {
@@ -45,8 +45,8 @@ pub(crate) fn build(w: &[u32], nb: &[u32], tri: &mut Triangles) -> Groups {
             if assigned[k] {
                 continue;
             }
-            let rep = w[k];
-            let o = tri.orient[t];
+            let rep = w.at(k);
+            let o = orient[t];
             assigned[k] = true;
             g.members.push(k as u32);
             stack.clear();
@@ -63,10 +63,10 @@ pub(crate) fn build(w: &[u32], nb: &[u32], tri: &mut Triangles) -> Groups {
                 if assigned[ku] {
                     continue;
                 }
-                if tri.gwa[u] && !assigned[3 * u] && !assigned[3 * u + 1] && !assigned[3 * u + 2] {
-                    tri.orient[u] = o;
+                if gwa[u] && !assigned[3 * u] && !assigned[3 * u + 1] && !assigned[3 * u + 2] {
+                    orient[u] = o;
                 }
-                if tri.orient[u] != o {
+                if orient[u] != o {
                     continue;
                 }
                 assigned[ku] = true;
@@ -78,7 +78,6 @@ pub(crate) fn build(w: &[u32], nb: &[u32], tri: &mut Triangles) -> Groups {
                 }
             }
             g.start.push(g.members.len() as u32);
-            g.rep.push(rep);
             g.orient.push(o);
         }
     }

@@ -27,6 +27,7 @@ mod shortcut;
 mod triangles;
 mod weld;
 
+use super::frames::{Frames, NO_FRAME};
 use super::TriMesh;
 use math::V3;
 use rayon::prelude::*;
@@ -65,18 +66,15 @@ pub enum Unsupported {
     TooLarge,
 }
 
-/// Per-corner frames `(t.x, t.y, t.z, sign)`, identical to the reference's; all zero (`w == 0`)
-/// where the reference gives no answer. The vector has one entry per index (a trailing partial
-/// triangle gets none, as with the reference wrapper).
-pub fn generate(mesh: &TriMesh) -> Result<Vec<[f32; 4]>, Unsupported> {
+/// Per-corner frames `(t.x, t.y, t.z, sign)`, identical to the reference's, one value per group
+/// of corners the reference summed together; no frame where the reference gives no answer. One
+/// slot per index (a trailing partial triangle gets none, as with the reference wrapper).
+pub fn generate(mesh: &TriMesh) -> Result<Frames, Unsupported> {
     generate_timed(mesh, &mut crate::report::Timings::default())
 }
 
 /// [`generate`], recording the wall time of each stage in `timings`.
-pub fn generate_timed(
-    mesh: &TriMesh,
-    timings: &mut crate::report::Timings,
-) -> Result<Vec<[f32; 4]>, Unsupported> {
+pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::report::Timings) -> Result<Frames, Unsupported> {
     let n_faces = mesh.indices.len() / 3;
     if n_faces.checked_mul(3).is_none_or(|n| n >= (u32::MAX as usize) - 4) {
         return Err(Unsupported::TooLarge);
@@ -87,69 +85,117 @@ pub fn generate_timed(
     }
     let c = Corners { mesh };
     if n_faces == 0 {
-        return Ok(vec![[0.0; 4]; mesh.indices.len()]);
+        return Ok(Frames { slot: vec![NO_FRAME; mesh.indices.len()], values: Vec::new() });
     }
     let mut tri = timings.time("triangles", || triangles::Triangles::build(&c));
     let ng = tri.n_good;
-    let (welded, short_tail) = timings.time("weld", || match shortcut::weld(&c, &tri.order, ng) {
-        Some(w) => (w, true),
-        None => (weld::weld(&c, &tri.order), false),
-    });
-    let w = &welded[..3 * ng];
-    let nb = timings.time("neighbors", || neighbors::build(w, 3 * n_faces, short_tail));
+    // The shortcut's ids are the same for every corner of an input vertex: they are kept per
+    // vertex (a sixth of the memory on a typical mesh) and read through the index buffer.
+    let by_vertex = timings.time("weld", || shortcut::weld(&c, &tri.order, ng));
+    match by_vertex {
+        Some(of_vertex) => {
+            let w = ByVertex { of_vertex, idx: mesh.indices, order: &tri.order, identity: ng == n_faces };
+            Ok(finish(&c, &w, true, &mut tri.gwa, &mut tri.orient, &tri.order, ng, timings))
+        }
+        None => {
+            let w = timings.time("weld", || weld::weld(&c, &tri.order));
+            Ok(finish(&c, w.as_slice(), false, &mut tri.gwa, &mut tri.orient, &tri.order, ng, timings))
+        }
+    }
+}
+
+/// Welded ids by internal corner (`3 t + j`, `t` in [`triangles::Triangles::order`]), for every
+/// corner of the mesh: degenerate triangles' corners come after the good ones.
+pub(crate) trait Welded: Sync {
+    fn at(&self, k: usize) -> u32;
+}
+
+impl Welded for [u32] {
+    #[inline]
+    fn at(&self, k: usize) -> u32 {
+        self[k]
+    }
+}
+
+/// Welded ids kept per input vertex.
+struct ByVertex<'a> {
+    of_vertex: Vec<u32>,
+    idx: &'a [u32],
+    order: &'a [u32],
+    /// No degenerate triangles: the internal order is the input order.
+    identity: bool,
+}
+
+impl Welded for ByVertex<'_> {
+    #[inline]
+    fn at(&self, k: usize) -> u32 {
+        let id = if self.identity { k } else { 3 * self.order[k / 3] as usize + k % 3 };
+        self.of_vertex[self.idx[id] as usize]
+    }
+}
+
+/// The stages after the weld: adjacency, groups, sums, output.
+#[allow(clippy::too_many_arguments)]
+fn finish<W: Welded + ?Sized>(
+    c: &Corners,
+    w: &W,
+    short_tail: bool,
+    gwa: &mut Vec<bool>,
+    orient: &mut [bool],
+    order: &[u32],
+    ng: usize,
+    timings: &mut crate::report::Timings,
+) -> Frames {
+    let n_faces = order.len();
+    let nb = timings.time("neighbors", || neighbors::build(w, 3 * ng, 3 * n_faces, short_tail));
     crate::report::mem_mark("engine neighbors");
-    let mut grp = timings.time("groups", || groups::build(w, &nb, &mut tri));
+    let mut grp = timings.time("groups", || groups::build(w, &nb, gwa, orient));
     crate::report::mem_mark("engine groups");
     drop(nb);
     // Sums are made a slice of groups at a time and kept compactly: one value for a group whose
-    // members all got the same bits (the usual case), else one per member. Only then are the
-    // per-triangle and welding arrays dropped and the per-corner output allocated, so the two
-    // never coexist.
+    // members all got the same bits (the usual case), else one per member.
     let t_acc = std::time::Instant::now();
-    let n_groups = grp.rep.len();
-    let mut first_slot: Vec<u32> = Vec::with_capacity(n_groups);
-    let mut uniform: Vec<bool> = Vec::with_capacity(n_groups);
-    let mut slots: Vec<V3> = Vec::with_capacity(n_groups);
+    let n_groups = grp.orient.len();
+    let mut first_slot: Vec<u32> = Vec::with_capacity(n_groups + 1);
+    let mut values: Vec<[f32; 4]> = Vec::with_capacity(n_groups);
     let mut g0 = 0;
     while g0 < n_groups {
         let limit = grp.start[g0] as usize + PASS;
         let g1 = (g0 + 1).max(grp.start.partition_point(|&x| (x as usize) <= limit) - 1).min(n_groups);
-        let vals = accumulate_all(&c, w, &tri, &mut grp, g0..g1);
+        let vals = accumulate_all(c, w, order, gwa, &mut grp, g0..g1);
         let base = grp.start[g0] as usize;
         for g in g0..g1 {
             let v = &vals[grp.start[g] as usize - base..grp.start[g + 1] as usize - base];
-            let same = v.iter().all(|x| x.map(f32::to_bits) == v[0].map(f32::to_bits));
-            first_slot.push(slots.len() as u32);
-            uniform.push(same);
-            if same {
-                slots.push(v[0]);
+            let sign = if grp.orient[g] { 1.0 } else { -1.0 };
+            first_slot.push(values.len() as u32);
+            if v.iter().all(|x| x.map(f32::to_bits) == v[0].map(f32::to_bits)) {
+                values.push([v[0][0], v[0][1], v[0][2], sign]);
             } else {
-                slots.extend_from_slice(v);
+                values.extend(v.iter().map(|x| [x[0], x[1], x[2], sign]));
             }
         }
         g0 = g1;
     }
+    first_slot.push(values.len() as u32);
     timings.stages.push(("accumulate".into(), t_acc.elapsed().as_secs_f64() * 1e3));
     crate::report::mem_mark("engine accumulate");
     let t_out = std::time::Instant::now();
-    (tri.s, tri.t, tri.gwa, grp.rep) = Default::default();
-    let welded = (ng < tri.order.len()).then_some(welded);
-    // Zeroed in parallel: the first touch of each page (a page fault) is shared between threads.
-    let mut out: Vec<[f32; 4]> = (0..mesh.indices.len()).into_par_iter().with_min_len(1 << 14).map(|_| [0.0; 4]).collect();
+    *gwa = Vec::new();
+    // Filled in parallel: the first touch of each page (a page fault) is shared between threads.
+    let mut slot: Vec<u32> = (0..c.mesh.indices.len()).into_par_iter().with_min_len(1 << 14).map(|_| NO_FRAME).collect();
     for g in 0..n_groups {
-        let sign = if grp.orient[g] { 1.0 } else { -1.0 };
         let range = grp.start[g] as usize..grp.start[g + 1] as usize;
+        let uniform = first_slot[g + 1] - first_slot[g] == 1;
         for (i, &k) in grp.members[range].iter().enumerate() {
-            let v = slots[first_slot[g] as usize + if uniform[g] { 0 } else { i }];
-            let corner = 3 * tri.order[(k / 3) as usize] as usize + (k % 3) as usize;
-            out[corner] = [v[0], v[1], v[2], sign];
+            let corner = 3 * order[(k / 3) as usize] as usize + (k % 3) as usize;
+            slot[corner] = first_slot[g] + if uniform { 0 } else { i as u32 };
         }
     }
-    if let Some(welded) = welded {
-        degenerate(&welded, &tri, n_faces, &mut out);
+    if ng < n_faces {
+        degenerate(w, order, ng, &mut slot);
     }
     timings.stages.push(("output".into(), t_out.elapsed().as_secs_f64() * 1e3));
-    Ok(out)
+    Frames { slot, values }
 }
 
 /// Members per pass of the sums (see [`generate_timed`]).
@@ -158,7 +204,7 @@ const PASS: usize = 1 << 18;
 /// Runs [`accumulate::group_tangents`] on the groups in `groups`, in parallel batches of whole
 /// groups; returns their members' sums. Sorts each group's members (the reference sums in
 /// triangle order).
-fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut groups::Groups, groups: std::ops::Range<usize>) -> Vec<V3> {
+fn accumulate_all<W: Welded + ?Sized>(c: &Corners, w: &W, order: &[u32], gwa: &[bool], grp: &mut groups::Groups, groups: std::ops::Range<usize>) -> Vec<V3> {
     const BATCH: usize = 8192;
     let n_groups = groups.end;
     let (lo, hi) = (grp.start[groups.start] as usize, grp.start[groups.end] as usize);
@@ -180,7 +226,7 @@ fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut 
         rest_v = tv;
         g0 = g1;
     }
-    let (start, rep) = (&grp.start, &grp.rep);
+    let start = &grp.start;
     batches.into_par_iter().for_each(|(g0, g1, ms, vs)| {
         let base = start[g0] as usize;
         let mut scratch = Vec::new();
@@ -188,7 +234,7 @@ fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut 
             let r = start[g] as usize - base..start[g + 1] as usize - base;
             let m = &mut ms[r.clone()];
             m.sort_unstable();
-            accumulate::group_tangents(c, w, tri, rep[g], m, &mut vs[r], &mut scratch);
+            accumulate::group_tangents(c, w, order, gwa, w.at(m[0] as usize), m, &mut vs[r], &mut scratch);
         }
     });
     vals
@@ -196,18 +242,17 @@ fn accumulate_all(c: &Corners, w: &[u32], tri: &triangles::Triangles, grp: &mut 
 
 /// Corners of degenerate triangles copy the output of the first good corner (in the
 /// reference's good-triangle order) with the same welded id, if any.
-fn degenerate(welded: &[u32], tri: &triangles::Triangles, n_faces: usize, out: &mut [[f32; 4]]) {
-    let ng = tri.n_good;
-    let corner = |k: usize| 3 * tri.order[k / 3] as usize + k % 3;
-    let mut first_good = vec![u32::MAX; 3 * n_faces];
-    for (k, &id) in welded[..3 * ng].iter().enumerate() {
-        let slot = &mut first_good[id as usize];
+fn degenerate<W: Welded + ?Sized>(w: &W, order: &[u32], ng: usize, out: &mut [u32]) {
+    let corner = |k: usize| 3 * order[k / 3] as usize + k % 3;
+    let mut first_good = vec![u32::MAX; 3 * order.len()];
+    for k in 0..3 * ng {
+        let slot = &mut first_good[w.at(k) as usize];
         if *slot == u32::MAX {
             *slot = k as u32;
         }
     }
-    for (k, &id) in welded.iter().enumerate().skip(3 * ng) {
-        let src = first_good[id as usize];
+    for k in 3 * ng..3 * order.len() {
+        let src = first_good[w.at(k) as usize];
         if src != u32::MAX {
             out[corner(k)] = out[corner(src as usize)];
         }

@@ -13,23 +13,23 @@
 //! key (a quickselect: linear expected time), and only when the tail has 3 or more edges (with
 //! fewer, every order pairs the same way).
 
+use super::Welded;
 use rayon::prelude::*;
 
 pub(crate) const NONE: u32 = u32::MAX;
 
 #[inline]
-fn edge_ends(w: &[u32], e: usize) -> (u32, u32) {
+fn edge_ends<W: Welded + ?Sized>(w: &W, e: usize) -> (u32, u32) {
     let t = e / 3;
     let n = e % 3;
-    (w[e], w[3 * t + (n + 1) % 3])
+    (w.at(e), w.at(3 * t + (n + 1) % 3))
 }
 
 /// `nb[3 t + n]`: the internal index of the triangle across edge `n` (corners `n`, `n + 1`) of
-/// good triangle `t`, or [`NONE`]. `w` holds the welded ids of the good triangles' corners;
-/// `id_space` bounds them. `short_tail`: fewer than 3 edges are known to share the largest `i0`
+/// good triangle `t`, or [`NONE`]. `w` gives the welded ids of the `n_edges` good triangles'
+/// corners; `id_space` bounds them. `short_tail`: fewer than 3 edges are known to share the largest `i0`
 /// (see [`super::shortcut`]), so no replay is needed whatever the ids.
-pub(crate) fn build(w: &[u32], id_space: usize, short_tail: bool) -> Vec<u32> {
-    let n_edges = w.len();
+pub(crate) fn build<W: Welded + ?Sized>(w: &W, n_edges: usize, id_space: usize, short_tail: bool) -> Vec<u32> {
     let mut nb = vec![NONE; n_edges];
     if n_edges == 0 {
         return nb;
@@ -62,47 +62,36 @@ pub(crate) fn build(w: &[u32], id_space: usize, short_tail: bool) -> Vec<u32> {
             v
         })
         .collect();
-    let pairs: Vec<Vec<(u32, u32)>> = (0..RANGES)
-        .into_par_iter()
-        .map(|r| {
-            let edges: Vec<u32> = per_chunk.iter().flat_map(|c| c[r].iter().copied()).collect();
-            let mut out = Vec::with_capacity(edges.len() / 2);
-            if edges.len() < 2 {
-                return out;
-            }
-            let base = (r as u32) << shift;
-            let span = 1usize << shift;
-            // Counting sort by i0 within the range (stable).
-            let mut start = vec![0u32; span + 1];
-            for &e in &edges {
-                start[(i0_of(w, e as usize) - base) as usize + 1] += 1;
-            }
-            for i in 0..span {
-                start[i + 1] += start[i];
-            }
-            let mut sorted = vec![0u32; edges.len()];
-            for &e in &edges {
-                let c = &mut start[(i0_of(w, e as usize) - base) as usize];
-                sorted[*c as usize] = e;
-                *c += 1;
-            }
-            let mut scratch: Vec<(u32, u32)> = Vec::new();
-            for bucket in sorted.chunk_by(|&a, &b| i0_of(w, a as usize) == i0_of(w, b as usize)) {
-                pair_bucket(w, bucket, &mut scratch, &mut |a, b| out.push((a, b)));
-            }
-            out
-        })
-        .collect();
-    drop(per_chunk);
+    // Regroup the chunks' lists by range (moves, no copies), then pair the ranges a wave at a
+    // time: each wave's lists are freed as it is paired and its pairs linked before the next,
+    // so neither all edges twice nor all pairs are ever held at once.
+    let mut by_range: Vec<Vec<Vec<u32>>> = (0..RANGES).map(|_| Vec::with_capacity(per_chunk.len())).collect();
+    for chunk in per_chunk {
+        for (r, list) in chunk.into_iter().enumerate() {
+            by_range[r].push(list);
+        }
+    }
     let mut link = |a: u32, b: u32| {
         nb[a as usize] = b / 3;
         nb[b as usize] = a / 3;
     };
-    for (a, b) in pairs.into_iter().flatten() {
-        link(a, b);
+    const WAVE: usize = 16;
+    for w0 in (0..RANGES).step_by(WAVE) {
+        let wave: Vec<Vec<Vec<u32>>> = by_range[w0..w0 + WAVE].iter_mut().map(std::mem::take).collect();
+        let pairs: Vec<Vec<(u32, u32)>> = wave
+            .into_par_iter()
+            .enumerate()
+            .map(|(i, lists)| {
+                let edges: Vec<u32> = lists.into_iter().flatten().collect();
+                pair_range(w, &edges, ((w0 + i) as u32) << shift, 1usize << shift)
+            })
+            .collect();
+        for (a, b) in pairs.into_iter().flatten() {
+            link(a, b);
+        }
     }
     if replay {
-        let tail = legacy_tail(w, max_i0);
+        let tail = legacy_tail(w, n_edges, max_i0);
         // Runs of equal i1, each sorted by triangle, except the last run (the off-by-one).
         let runs: Vec<&[u32]> =
             tail.chunk_by(|&a, &b| edge_ends_max(w, a as usize) == edge_ends_max(w, b as usize)).collect();
@@ -118,13 +107,40 @@ pub(crate) fn build(w: &[u32], id_space: usize, short_tail: bool) -> Vec<u32> {
 }
 
 #[inline]
-fn i0_of(w: &[u32], e: usize) -> u32 {
+fn i0_of<W: Welded + ?Sized>(w: &W, e: usize) -> u32 {
     let (a, b) = edge_ends(w, e);
     a.min(b)
 }
 
+/// Pairs the edges of one range of `i0` keys (`base..base + span`), given in triangle order.
+fn pair_range<W: Welded + ?Sized>(w: &W, edges: &[u32], base: u32, span: usize) -> Vec<(u32, u32)> {
+    let mut out = Vec::with_capacity(edges.len() / 2);
+    if edges.len() < 2 {
+        return out;
+    }
+    // Counting sort by i0 within the range (stable).
+    let mut start = vec![0u32; span + 1];
+    for &e in edges {
+        start[(i0_of(w, e as usize) - base) as usize + 1] += 1;
+    }
+    for i in 0..span {
+        start[i + 1] += start[i];
+    }
+    let mut sorted = vec![0u32; edges.len()];
+    for &e in edges {
+        let c = &mut start[(i0_of(w, e as usize) - base) as usize];
+        sorted[*c as usize] = e;
+        *c += 1;
+    }
+    let mut scratch: Vec<(u32, u32)> = Vec::new();
+    for bucket in sorted.chunk_by(|&a, &b| i0_of(w, a as usize) == i0_of(w, b as usize)) {
+        pair_bucket(w, bucket, &mut scratch, &mut |a, b| out.push((a, b)));
+    }
+    out
+}
+
 /// Pairs the edges of one `i0` bucket (given in triangle order): runs of equal `i1`.
-fn pair_bucket(w: &[u32], bucket: &[u32], scratch: &mut Vec<(u32, u32)>, link: &mut impl FnMut(u32, u32)) {
+fn pair_bucket<W: Welded + ?Sized>(w: &W, bucket: &[u32], scratch: &mut Vec<(u32, u32)>, link: &mut impl FnMut(u32, u32)) {
     match bucket.len() {
         0 | 1 => {}
         2 => {
@@ -150,7 +166,7 @@ fn pair_bucket(w: &[u32], bucket: &[u32], scratch: &mut Vec<(u32, u32)>, link: &
 }
 
 #[inline]
-fn edge_ends_max(w: &[u32], e: usize) -> u32 {
+fn edge_ends_max<W: Welded + ?Sized>(w: &W, e: usize) -> u32 {
     let (a, b) = edge_ends(w, e);
     a.max(b)
 }
@@ -158,7 +174,7 @@ fn edge_ends_max(w: &[u32], e: usize) -> u32 {
 /// Greedy pairing of one run of same-key edges in the given order: each free edge takes the
 /// first later free edge running the opposite way. A pointer per direction makes it linear
 /// (the taken edges after any position form a prefix of that direction's later edges).
-fn pair_run(w: &[u32], run: &[u32], link: &mut impl FnMut(u32, u32)) {
+fn pair_run<W: Welded + ?Sized>(w: &W, run: &[u32], link: &mut impl FnMut(u32, u32)) {
     let dir = |e: u32| {
         let (a, b) = edge_ends(w, e as usize);
         (a > b) as usize
@@ -200,8 +216,8 @@ const SORT_SEED: u32 = 39871946;
 
 /// The edges with the largest `i0`, in the order the reference's seeded quicksort on `i0`
 /// leaves them. Sub-ranges without a largest key are never sorted (they cannot move it).
-fn legacy_tail(w: &[u32], max_i0: u32) -> Vec<u32> {
-    let mut v: Vec<(u32, u32)> = (0..w.len())
+fn legacy_tail<W: Welded + ?Sized>(w: &W, n_edges: usize, max_i0: u32) -> Vec<u32> {
+    let mut v: Vec<(u32, u32)> = (0..n_edges)
         .map(|e| {
             let (a, b) = edge_ends(w, e);
             (a.min(b), e as u32)

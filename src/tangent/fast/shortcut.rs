@@ -28,7 +28,7 @@ use rayon::prelude::*;
 const MAX_CANDIDATES: usize = 256;
 
 /// Welded ids as [`super::weld::weld`] gives them, up to the choice of representative within each
-/// class, or `None` when that choice could change the output (or the input has NaN or huge
+/// class, per input vertex (every corner of a vertex has its vertex's id), or `None` when that choice could change the output (or the input has NaN or huge
 /// coordinates): the caller then replays the reference.
 pub(crate) fn weld(c: &Corners, order: &[u32], n_good: usize) -> Option<Vec<u32>> {
     let idx = &c.mesh.indices[..3 * order.len()];
@@ -98,5 +98,5 @@ pub(crate) fn weld(c: &Corners, order: &[u32], n_good: usize) -> Option<Vec<u32>
             return None;
         }
     }
-    Some((0..idx.len()).into_par_iter().with_min_len(1 << 14).map(|k| first[class_of(id_of(k))]).collect())
+    Some((0..n_vertices).into_par_iter().with_min_len(1 << 14).map(|v| first[class[v] as usize]).collect())
 }

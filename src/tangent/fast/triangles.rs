@@ -10,10 +10,6 @@ pub(crate) struct Triangles {
     /// Internal index -> input face index. The first `n_good` are non-degenerate.
     pub order: Vec<u32>,
     pub n_good: usize,
-    /// Normalised, orientation-signed first-order tangent (`s`) and bitangent (`t`) of each
-    /// non-degenerate triangle; zero where the UV area vanishes.
-    pub s: Vec<V3>,
-    pub t: Vec<V3>,
     /// UV orientation (`signed area > 0`). Mutable: "group with anything" triangles take the
     /// orientation of the first group that reaches them.
     pub orient: Vec<bool>,
@@ -74,15 +70,24 @@ impl Triangles {
         let mut order = Vec::with_capacity(n_faces);
         order.extend((0..n_faces).filter(|&f| !degen[f]).map(|f| f as u32));
         order.extend((0..n_faces).filter(|&f| degen[f]).map(|f| f as u32));
-        // Straight into the four arrays: no temporary array of records.
-        let ((s, t), (orient, gwa)): ((Vec<V3>, Vec<V3>), (Vec<bool>, Vec<bool>)) = order[..n_good]
+        // The first-order vectors are not kept (24 bytes a triangle, the engine's largest
+        // array): the sums recompute them from the corners, which costs less than the memory.
+        let (orient, gwa): (Vec<bool>, Vec<bool>) = order[..n_good]
             .par_iter()
             .map(|&f| {
                 let i = info(c, f as usize);
-                ((i.s, i.t), (i.orient, i.gwa))
+                (i.orient, i.gwa)
             })
             .unzip();
-        Triangles { order, n_good, s, t, orient, gwa }
+        Triangles { order, n_good, orient, gwa }
     }
 }
 
+/// Normalised, orientation-signed first-order tangent (`s`) and bitangent (`t`) of input face
+/// `f` (non-degenerate); zero where the UV area vanishes. Recomputed on each call, bit for bit
+/// the same every time.
+#[inline]
+pub(crate) fn first_order(c: &Corners, f: usize) -> (V3, V3) {
+    let i = info(c, f);
+    (i.s, i.t)
+}
