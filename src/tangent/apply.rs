@@ -83,13 +83,15 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
             }
         }
     }
+    // The decoded copies are all that is needed now: free the bytes they came from.
+    scene.release_primitives(&work.iter().map(|w| w.0).collect::<Vec<_>>());
     let v_up = scene.uv_v_up;
     let done: Vec<(Primitive, FrameStats)> = work
         .par_iter()
         .map(|(_, set, p, _)| primitive_with_stats(p, *set, v_up, &opts.frames))
         .collect();
     for ((r, ..), (p, stats)) in work.iter().zip(done) {
-        scene.set_primitive(*r, &p);
+        scene.put_primitive(*r, p);
         if let Some(rep) = reports.iter_mut().find(|x| x.mesh == r.mesh && x.primitive == r.primitive) {
             rep.stats = Some(stats);
         }
