@@ -3,28 +3,35 @@
 //! touches its input (even when the output path is the input path).
 
 use crate::error::{Error, Result};
+use std::borrow::Cow;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A set of files that appear together or not at all (a `.gltf` and its `.bin`, say).
+/// Parts may borrow what they write (a scene's buffers), so the bytes need not exist twice.
 #[derive(Default)]
-pub struct Outputs {
+pub struct Outputs<'a> {
     /// Each file as parts written one after the other (a GLB's header and JSON, then its
     /// binary chunk, need not be copied into one buffer).
-    files: Vec<(PathBuf, Vec<Vec<u8>>)>,
+    files: Vec<(PathBuf, Vec<Cow<'a, [u8]>>)>,
 }
 
-impl Outputs {
+impl<'a> Outputs<'a> {
     pub fn new() -> Self {
         Self::default()
     }
     /// Queues `bytes` to be written at `path`.
     pub fn add(&mut self, path: impl Into<PathBuf>, bytes: Vec<u8>) {
-        self.files.push((path.into(), vec![bytes]));
+        self.files.push((path.into(), vec![Cow::Owned(bytes)]));
     }
     /// Queues a file made of `parts`, in order.
-    pub fn add_parts(&mut self, path: impl Into<PathBuf>, parts: Vec<Vec<u8>>) {
+    pub fn add_parts(&mut self, path: impl Into<PathBuf>, parts: Vec<Cow<'a, [u8]>>) {
         self.files.push((path.into(), parts));
+    }
+    /// The same files, owning their bytes (for when what they borrow from goes away).
+    pub fn into_owned(self) -> Outputs<'static> {
+        let files = self.files.into_iter().map(|(p, parts)| (p, parts.into_iter().map(|b| Cow::Owned(b.into_owned())).collect())).collect();
+        Outputs { files }
     }
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
         self.files.iter().map(|(p, _)| p.as_path())
@@ -80,11 +87,12 @@ fn write_temp(path: &Path, parts: &[impl AsRef<[u8]>]) -> Result<PathBuf> {
     let name = path.file_name().ok_or_else(|| Error::output(path, "not a file name"))?;
     let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
     let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
+        // Buffered: a GLB's binary chunk can be thousands of small parts (views and padding).
+        let mut f = std::io::BufWriter::with_capacity(1 << 16, std::fs::File::create(&tmp)?);
         for bytes in parts {
             f.write_all(bytes.as_ref())?;
         }
-        f.sync_all()
+        f.into_inner().map_err(|e| e.into_error())?.sync_all()
     })();
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);

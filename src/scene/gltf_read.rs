@@ -119,6 +119,7 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
         notes: Vec::new(),
         deps,
         height_maps: Vec::new(),
+        ledger: Default::default(),
         own_images: false,
     };
     check_views(&scene)?;

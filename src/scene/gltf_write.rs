@@ -4,11 +4,13 @@
 //! into one buffer, and renumbers the references. Anything it cannot prove unreferenced (data an
 //! unknown extension might point at) is kept.
 
-use super::{as_index, uri, Scene};
+use super::compact::{drop_unreferenced, pack_views, set_offset, Dangling};
+use super::{uri, Scene};
 use crate::error::{Error, Result};
 use crate::output::Outputs;
 use base64::Engine as _;
 use serde_json::{json, Value};
+use std::borrow::Cow;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -69,34 +71,34 @@ pub struct WriteStats {
 }
 
 /// Builds every file the output consists of; the caller commits them (atomically, together).
-pub fn write(scene: &Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs, WriteStats)> {
+/// The binary data is not copied: the files borrow it from `scene`.
+pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs<'a>, WriteStats)> {
+    if scene.uv_v_up {
+        let flipped = super::obj::flip_uvs_to_gltf(scene)?;
+        return write_gltf(&flipped, out, opts).map(|(files, stats)| (files.into_owned(), stats));
+    }
+    write_gltf(scene, out, opts)
+}
+
+fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs<'a>, WriteStats)> {
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let glb = match ext.as_str() {
         "glb" => true,
         "gltf" => false,
         _ => return Err(Error::usage(format!("{}: output must end in .gltf or .glb", out.display()))),
     };
-    let flipped;
-    let scene = if scene.uv_v_up {
-        flipped = super::obj::flip_uvs_to_gltf(scene)?;
-        &flipped
-    } else {
-        scene
-    };
     let mut json = scene.json.clone();
-    let mut stats = WriteStats { buffer_bytes_in: scene.buffers.iter().map(|b| b.len()).sum(), ..Default::default() };
+    let held: usize = scene.buffers.iter().map(|b| b.len()).sum();
+    let mut stats = WriteStats { buffer_bytes_in: held + scene.ledger.bytes_unheld, ..Default::default() };
     let keep_all = uses_unknown_extension(&json);
-    let mut bin: Vec<u8> = Vec::new();
+    let mut bin = Bin::default();
     let mut files = Outputs::new();
     let out_dir = out.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+    let dangling = |what: &str, Dangling(i, n)| scene.err(format!("{what} {i} is referenced but does not exist ({n} in the file)"));
 
     // Accessors.
-    let n_acc = json.get("accessors").and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0);
-    let acc_keep: BTreeSet<usize> = if keep_all { (0..n_acc).collect() } else { accessor_refs(&mut json, &mut |_| {}) };
-    check_refs(scene, "accessor", &acc_keep, n_acc)?;
-    let acc_map = renumber(&mut json, "accessors", &acc_keep);
-    accessor_refs(&mut json, &mut |i| *i = acc_map[*i].expect("kept accessor"));
-    stats.accessors_dropped = n_acc - acc_keep.len();
+    let dropped = drop_unreferenced(&mut json, "accessors", keep_all, accessor_refs).map_err(|d| dangling("accessor", d))?;
+    stats.accessors_dropped = dropped + scene.ledger.accessors_dropped;
 
     // Images: embedded, copied or written out, before buffer views are renumbered.
     let images = json.get("images").and_then(|i| i.as_array()).cloned().unwrap_or_default();
@@ -158,52 +160,38 @@ pub fn write(scene: &Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs,
     }
 
     // Buffer views: keep what kept accessors, images and compressed primitives use; repack.
-    let n_views = json.get("bufferViews").and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0);
-    let view_keep: BTreeSet<usize> = if keep_all { (0..n_views).collect() } else { view_refs(&mut json, &mut |_| {}) };
-    check_refs(scene, "bufferView", &view_keep, n_views)?;
-    let view_map = renumber(&mut json, "bufferViews", &view_keep);
-    view_refs(&mut json, &mut |i| *i = view_map[*i].expect("kept view"));
-    stats.buffer_views_dropped = n_views - view_keep.len();
-    if let Some(views) = json.get_mut("bufferViews").and_then(|v| v.as_array_mut()) {
-        let total: usize = views.iter().map(|v| v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize + 3).sum();
-        bin.reserve_exact(total + pending_views.iter().map(|(b, _)| b.len() + 3).sum::<usize>() + 3);
-        for v in views.iter_mut() {
-            let b = v.get("buffer").and_then(as_index).unwrap_or(0);
-            let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-            let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-            let src = scene.buffers.get(b).and_then(|buf| buf.get(off..off + len)).ok_or_else(|| scene.err("bufferView runs past its buffer"))?;
-            pad4(&mut bin, 0);
-            let at = bin.len();
-            bin.extend_from_slice(src);
-            v["buffer"] = json!(0);
-            set_offset(v, at);
-        }
+    let dropped = drop_unreferenced(&mut json, "bufferViews", keep_all, view_refs).map_err(|d| dangling("bufferView", d))?;
+    stats.buffer_views_dropped = dropped + scene.ledger.views_dropped;
+    for p in pack_views(&mut json, &scene.buffers).ok_or_else(|| scene.err("bufferView runs past its buffer"))? {
+        bin.pad4();
+        debug_assert_eq!(bin.len, p.at);
+        bin.push(Cow::Borrowed(&scene.buffers[p.buffer][p.range]));
     }
     for (bytes, img) in pending_views {
-        pad4(&mut bin, 0);
-        let at = bin.len();
-        bin.extend_from_slice(&bytes);
-        let views = super::array_mut(&mut json, "bufferViews");
+        bin.pad4();
+        let at = bin.len;
         let mut v = json!({ "buffer": 0, "byteLength": bytes.len() });
         set_offset(&mut v, at);
+        bin.push(Cow::Owned(bytes));
+        let views = super::array_mut(&mut json, "bufferViews");
         views.push(v);
         json["images"][img]["bufferView"] = json!(views_len(&json) - 1);
     }
-    stats.buffer_bytes_out = bin.len();
+    stats.buffer_bytes_out = bin.len;
 
     // One buffer, or none.
     let root = json.as_object_mut().ok_or_else(|| scene.err("glTF JSON is not an object"))?;
-    if bin.is_empty() && !root.contains_key("bufferViews") {
+    if bin.len == 0 && !root.contains_key("bufferViews") {
         root.remove("buffers");
     } else {
-        let mut b = json!({ "byteLength": bin.len() });
+        let mut b = json!({ "byteLength": bin.len });
         if !glb {
             if opts.embed {
-                b["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin)));
+                b["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(bin.parts.concat())));
             } else {
                 let name = format!("{}.bin", out.file_stem().and_then(|s| s.to_str()).unwrap_or("scene"));
                 b["uri"] = json!(name);
-                files.add(out_dir.join(&name), std::mem::take(&mut bin));
+                files.add_parts(out_dir.join(&name), std::mem::take(&mut bin).parts);
             }
         }
         root.insert("buffers".into(), json!([b]));
@@ -224,40 +212,39 @@ pub fn write(scene: &Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs,
     Ok((files, stats))
 }
 
-fn check_refs(scene: &Scene, what: &str, refs: &BTreeSet<usize>, n: usize) -> Result<()> {
-    match refs.iter().next_back() {
-        Some(&i) if i >= n => Err(scene.err(format!("{what} {i} is referenced but does not exist ({n} in the file)"))),
-        _ => Ok(()),
-    }
-}
-
 fn views_len(json: &Value) -> usize {
     json.get("bufferViews").and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0)
 }
 
-fn set_offset(v: &mut Value, at: usize) {
-    if at == 0 {
-        if let Some(o) = v.as_object_mut() {
-            o.remove("byteOffset");
+/// The output buffer as the pieces it is made of, most of them borrowed from the scene: the
+/// scene's bytes need not exist twice while the file is written.
+#[derive(Default)]
+struct Bin<'a> {
+    parts: Vec<Cow<'a, [u8]>>,
+    len: usize,
+}
+
+impl<'a> Bin<'a> {
+    fn push(&mut self, bytes: Cow<'a, [u8]>) {
+        self.len += bytes.len();
+        self.parts.push(bytes);
+    }
+    /// Zeros up to the next multiple of 4.
+    fn pad4(&mut self) {
+        let n = self.len.next_multiple_of(4) - self.len;
+        if n > 0 {
+            self.push(Cow::Borrowed(&[0u8; 3][..n]));
         }
-    } else {
-        v["byteOffset"] = json!(at);
     }
 }
 
-fn pad4(buf: &mut Vec<u8>, fill: u8) {
-    while buf.len() % 4 != 0 {
-        buf.push(fill);
-    }
-}
-
-/// The GLB container: header and JSON chunk, then the binary chunk (`bin`, not copied).
-fn glb_parts(json: &Value, mut b: Vec<u8>) -> Vec<Vec<u8>> {
+/// The GLB container: header and JSON chunk, then the binary chunk (`b`'s parts, not copied).
+fn glb_parts<'a>(json: &Value, mut b: Bin<'a>) -> Vec<Cow<'a, [u8]>> {
     let mut j = serde_json::to_vec(json).expect("a Value always serialises");
-    pad4(&mut j, b' ');
-    pad4(&mut b, 0);
-    let has_bin = !b.is_empty() || json.get("buffers").is_some();
-    let total = 12 + 8 + j.len() + if has_bin { 8 + b.len() } else { 0 };
+    j.resize(j.len().next_multiple_of(4), b' ');
+    b.pad4();
+    let has_bin = b.len != 0 || json.get("buffers").is_some();
+    let total = 12 + 8 + j.len() + if has_bin { 8 + b.len } else { 0 };
     let mut out = Vec::with_capacity(12 + 8 + j.len() + 8);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
@@ -266,15 +253,18 @@ fn glb_parts(json: &Value, mut b: Vec<u8>) -> Vec<Vec<u8>> {
     out.extend_from_slice(&0x4E4F534Au32.to_le_bytes());
     out.extend_from_slice(&j);
     if !has_bin {
-        return vec![out];
+        return vec![Cow::Owned(out)];
     }
-    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(&(b.len as u32).to_le_bytes());
     out.extend_from_slice(&0x004E4942u32.to_le_bytes());
-    vec![out, b]
+    let mut parts = Vec::with_capacity(1 + b.parts.len());
+    parts.push(Cow::Owned(out));
+    parts.extend(b.parts);
+    parts
 }
 
 /// Copies an external image next to the output (unless it is already there).
-fn copy_beside(img: &mut Value, u: &str, scene: &Scene, out_dir: &Path, files: &mut Outputs) -> Result<()> {
+fn copy_beside(img: &mut Value, u: &str, scene: &Scene, out_dir: &Path, files: &mut Outputs<'_>) -> Result<()> {
     let src = match uri::resolve(u, &scene.base_dir, &scene.source, scene.allow_outside)? {
         uri::Target::File(p) => p,
         uri::Target::Data { .. } => return Ok(()),
@@ -338,7 +328,7 @@ fn sniff_mime(bytes: &[u8], uri: &str) -> String {
     }
 }
 
-fn uses_unknown_extension(json: &Value) -> bool {
+pub(super) fn uses_unknown_extension(json: &Value) -> bool {
     json.get("extensionsUsed")
         .and_then(|e| e.as_array())
         .map(|list| list.iter().any(|e| !KNOWN_EXTENSIONS.contains(&e.as_str().unwrap_or(""))))
@@ -346,22 +336,12 @@ fn uses_unknown_extension(json: &Value) -> bool {
 }
 
 /// Visits every accessor reference; returns the set of indices seen.
-fn accessor_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
+pub(super) fn accessor_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
     let mut seen = BTreeSet::new();
     let mut visit = |v: &mut Value| visit_index(v, &mut seen, f);
     for mesh in arr_mut(json, "meshes") {
         for p in arr_mut(mesh, "primitives") {
-            for a in obj_values_mut(p.get_mut("attributes")) {
-                visit(a);
-            }
-            if let Some(i) = p.get_mut("indices") {
-                visit(i);
-            }
-            for t in arr_mut(p, "targets") {
-                for a in obj_values_mut(Some(t)) {
-                    visit(a);
-                }
-            }
+            primitive_accessor_refs(p, &mut visit);
         }
     }
     for skin in arr_mut(json, "skins") {
@@ -387,8 +367,23 @@ fn accessor_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<us
     seen
 }
 
+/// Visits the accessor references of one primitive: attributes, indices, morph targets.
+pub(super) fn primitive_accessor_refs(p: &mut Value, visit: &mut dyn FnMut(&mut Value)) {
+    for a in obj_values_mut(p.get_mut("attributes")) {
+        visit(a);
+    }
+    if let Some(i) = p.get_mut("indices") {
+        visit(i);
+    }
+    for t in arr_mut(p, "targets") {
+        for a in obj_values_mut(Some(t)) {
+            visit(a);
+        }
+    }
+}
+
 /// Visits every buffer-view reference; returns the set of indices seen.
-fn view_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
+pub(super) fn view_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
     let mut seen = BTreeSet::new();
     let mut visit = |v: &mut Value| visit_index(v, &mut seen, f);
     for a in arr_mut(json, "accessors") {
@@ -425,7 +420,7 @@ fn visit_index(v: &mut Value, seen: &mut BTreeSet<usize>, f: &mut dyn FnMut(&mut
 }
 
 /// Keeps the listed entries of `json[key]`; returns old index -> new index.
-fn renumber(json: &mut Value, key: &str, keep: &BTreeSet<usize>) -> Vec<Option<usize>> {
+pub(super) fn renumber(json: &mut Value, key: &str, keep: &BTreeSet<usize>) -> Vec<Option<usize>> {
     let list = json.get(key).and_then(|a| a.as_array()).cloned().unwrap_or_default();
     let mut map = vec![None; list.len().max(keep.iter().next_back().map(|m| m + 1).unwrap_or(0))];
     let mut kept = Vec::new();

@@ -7,6 +7,7 @@
 //! longer referenced. OBJ input is converted into the same model on reading.
 
 pub mod accessor;
+mod compact;
 mod gltf_read;
 mod gltf_write;
 pub mod image_limits;
@@ -63,6 +64,8 @@ pub struct Scene {
     pub deps: Vec<PathBuf>,
     /// Height maps named by OBJ `bump`/`map_Bump`, which only `bake` can turn into normal maps.
     pub height_maps: Vec<HeightMapRef>,
+    /// What compaction and appending did, for the writer's report.
+    pub(crate) ledger: compact::Ledger,
 }
 
 /// A height map a material wants as its bump map.
@@ -311,66 +314,71 @@ impl Scene {
         gltf_read::read_accessor(self, idx)
     }
 
-    /// Puts a primitive back: its streams become new accessors in a new buffer, and the
-    /// primitive's JSON points at them. Old accessors are left for the writer to drop.
+    /// Puts a primitive back: its streams become new accessors, and the primitive's JSON points
+    /// at them. Old accessors are left for the writer to drop.
     pub fn set_primitive(&mut self, r: PrimRef, p: &Primitive) {
-        // Room for every stream at once: one reallocation, not a doubling per stream.
-        let bytes: usize = p.attributes.iter().chain(p.targets.iter().flatten()).map(|(_, s)| s.data.len() + 3).sum::<usize>() + 4 * p.indices.len() + 3;
-        if let Some(last) = self.buffers.last_mut() {
-            last.reserve_exact(bytes);
-        }
+        self.put_primitive(r, p.clone());
+    }
+
+    /// [`set_primitive`](Self::set_primitive) that moves the streams' bytes into the scene (each
+    /// becomes a buffer of its own) instead of copying them.
+    pub fn put_primitive(&mut self, r: PrimRef, p: Primitive) {
+        let Primitive { attributes, targets, indices, mode } = p;
+        let mut index_stream = index_stream(&indices, attributes.first().map(|(_, s)| s.len()).unwrap_or(0));
+        drop(indices);
+        let has_targets = !targets.is_empty();
         let mut attrs = serde_json::Map::new();
-        for (name, s) in &p.attributes {
-            let i = self.push_accessor(s, Some(34962), name == "POSITION");
-            attrs.insert(name.clone(), json!(i));
+        for (name, s) in attributes {
+            let i = self.push_stream(s, Some(34962), name == "POSITION");
+            attrs.insert(name, json!(i));
         }
-        let mut targets = Vec::new();
-        for t in &p.targets {
+        let mut target_maps = Vec::new();
+        for t in targets {
             let mut m = serde_json::Map::new();
             for (name, s) in t {
-                let i = self.push_accessor(s, Some(34962), name == "POSITION");
-                m.insert(name.clone(), json!(i));
+                let i = self.push_stream(s, Some(34962), name == "POSITION");
+                m.insert(name, json!(i));
             }
-            targets.push(Value::Object(m));
+            target_maps.push(Value::Object(m));
         }
-        let index_stream = index_stream(&p.indices, p.vertex_count());
-        let old_indices = self.prim_json(r).get("indices").and_then(as_index);
-        let mut index_stream = index_stream;
-        index_stream.template = old_indices.and_then(|i| self.array("accessors").get(i).cloned());
-        let ii = self.push_accessor(&index_stream, Some(34963), false);
+        index_stream.template = match self.ledger.detached.remove(&r) {
+            Some(template) => Some(template),
+            None => self.prim_json(r).get("indices").and_then(as_index).and_then(|i| self.array("accessors").get(i).cloned()),
+        };
+        let ii = self.push_stream(index_stream, Some(34963), false);
         let pj = self.prim_json_mut(r);
         pj["attributes"] = Value::Object(attrs);
         pj["indices"] = json!(ii);
-        if !p.targets.is_empty() {
-            pj["targets"] = Value::Array(targets);
+        if has_targets {
+            pj["targets"] = Value::Array(target_maps);
         }
         if let Some(o) = pj.as_object_mut() {
-            if p.mode == 4 {
+            if mode == 4 {
                 o.remove("mode");
             } else {
-                o.insert("mode".into(), json!(p.mode));
+                o.insert("mode".into(), json!(mode));
             }
         }
     }
 
     /// Appends a stream as a new buffer view + accessor; returns the accessor index.
     pub fn push_accessor(&mut self, s: &Stream, target: Option<u32>, min_max: bool) -> usize {
+        self.push_stream(s.clone(), target, min_max)
+    }
+
+    /// [`push_accessor`](Self::push_accessor) that moves the stream's bytes into a buffer of
+    /// their own: no copy, and no growing buffer to reallocate. The writer packs all buffers
+    /// into one anyway.
+    pub fn push_stream(&mut self, s: Stream, target: Option<u32>, min_max: bool) -> usize {
         if self.buffers.is_empty() || self.json.pointer("/buffers/0").is_none() {
             self.buffers.clear();
-            self.json["buffers"] = json!([{ "byteLength": 0 }]);
-            self.buffers.push(Vec::new());
+            self.json["buffers"] = json!([]);
+            self.ledger.restart();
         }
-        // New data goes into the last buffer; the writer repacks everything into one anyway.
-        let b = self.buffers.len() - 1;
-        let buf = &mut self.buffers[b];
-        while buf.len() % 4 != 0 {
-            buf.push(0);
-        }
-        let offset = buf.len();
-        buf.extend_from_slice(&s.data);
-        let len = buf.len();
-        self.json["buffers"][b]["byteLength"] = json!(len);
-        let mut view = json!({ "buffer": b, "byteOffset": offset, "byteLength": s.data.len() });
+        self.ledger.appended(s.data.len(), self.buffers.last().map_or(0, |b| b.len()));
+        // byteOffset 0 rather than none: the writer edits the key in place, so the view's keys
+        // keep the order they always had in the output.
+        let mut view = json!({ "buffer": self.buffers.len(), "byteOffset": 0, "byteLength": s.data.len() });
         if let Some(t) = target {
             view["target"] = json!(t);
         }
@@ -406,6 +414,8 @@ impl Scene {
             acc["min"] = json!(lo);
             acc["max"] = json!(hi);
         }
+        array_mut(&mut self.json, "buffers").push(json!({ "byteLength": s.data.len() }));
+        self.buffers.push(s.data);
         let accs = array_mut(&mut self.json, "accessors");
         accs.push(acc);
         accs.len() - 1

@@ -43,6 +43,7 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
         notes: Vec::new(),
         deps: mtl_files.into_inner(),
         height_maps: Vec::new(),
+        ledger: Default::default(),
         own_images: true,
     };
     for (i, m) in materials.iter().enumerate() {
@@ -71,7 +72,7 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
         let prims = scene.json["meshes"][mesh_idx]["primitives"].as_array_mut().expect("primitives array");
         prims.push(pj);
         let r = PrimRef { mesh: mesh_idx, primitive: prims.len() - 1 };
-        scene.set_primitive(r, &prim);
+        scene.put_primitive(r, prim);
     }
     if nodes.is_empty() {
         return Err(Error::input(path, "OBJ has no faces"));
@@ -367,7 +368,7 @@ pub fn flip_uvs_to_gltf(scene: &Scene) -> Result<Scene> {
                 s.template = template;
             }
         }
-        out.set_primitive(r, &p);
+        out.put_primitive(r, p);
     }
     out.uv_v_up = false;
     Ok(out)

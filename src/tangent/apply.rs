@@ -83,14 +83,16 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
             }
         }
     }
-    let v_up = scene.uv_v_up;
+    // The decoded copies are all that is needed now: free the bytes they came from.
     let refs: Vec<PrimRef> = work.iter().map(|w| w.0).collect();
+    scene.release_primitives(&refs);
+    let v_up = scene.uv_v_up;
     let done: Vec<(Primitive, FrameStats)> = work
         .into_par_iter()
         .map(|(_, set, p, _)| primitive_with_stats(p, set, v_up, &opts.frames))
         .collect();
     for (r, (p, stats)) in refs.iter().zip(done) {
-        scene.set_primitive(*r, &p);
+        scene.put_primitive(*r, p);
         if let Some(rep) = reports.iter_mut().find(|x| x.mesh == r.mesh && x.primitive == r.primitive) {
             rep.stats = Some(stats);
         }
