@@ -18,7 +18,7 @@
 //! O(size - first excluded position) per distinct exclusion set.
 
 use super::math::{acos, add, dot, normalized_or_zero, project, scale, sub, V3};
-use super::triangles;
+
 use super::{Corners, Welded};
 use std::collections::HashMap;
 
@@ -41,11 +41,12 @@ fn compatible(a: &Member, b: &Member) -> bool {
 }
 
 /// Computes the output tangent of every member of one group. `members` are list entries
-/// `3 * t + j`, sorted ascending; `out[i]` receives member `i`'s normalised tangent.
+/// `3 * t + j`, sorted ascending; `st(t)` gives triangle `t`'s first-order vectors; `out[i]`
+/// receives member `i`'s normalised tangent.
 pub(crate) fn group_tangents<W: Welded + ?Sized>(
     c: &Corners,
     w: &W,
-    order: &[u32],
+    st: &(impl Fn(usize) -> (V3, V3) + ?Sized),
     gwa: &[bool],
     rep: u32,
     members: &[u32],
@@ -56,7 +57,7 @@ pub(crate) fn group_tangents<W: Welded + ?Sized>(
     scratch.clear();
     scratch.extend(members.iter().map(|&k| {
             let (t, j) = ((k / 3) as usize, (k % 3) as usize);
-            let (s0, t0) = triangles::first_order(c, order[t] as usize);
+            let (s0, t0) = st(t);
             let s = project(s0, n);
             let tt = project(t0, n);
             let gwa = gwa[t];
@@ -64,9 +65,9 @@ pub(crate) fn group_tangents<W: Welded + ?Sized>(
                 [0.0; 3]
             } else {
                 let p = [
-                    c.pos(w.at(3 * t + (j + 1) % 3) as usize),
-                    c.pos(w.at(3 * t + j) as usize),
-                    c.pos(w.at(3 * t + (j + 2) % 3) as usize),
+                    c.pos(w.attr_corner(3 * t + (j + 1) % 3)),
+                    c.pos(w.attr_corner(3 * t + j)),
+                    c.pos(w.attr_corner(3 * t + (j + 2) % 3)),
                 ];
                 let v0 = project(sub(p[0], p[1]), n);
                 let v1 = project(sub(p[2], p[1]), n);

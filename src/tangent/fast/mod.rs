@@ -28,6 +28,7 @@ mod triangles;
 mod weld;
 
 use super::frames::{Frames, NO_FRAME};
+use triangles::Order;
 use super::TriMesh;
 use math::V3;
 use rayon::prelude::*;
@@ -92,25 +93,28 @@ pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::report::Timings) -> R
     // The shortcut's ids are the same for every corner of an input vertex: they are kept per
     // vertex (a sixth of the memory on a typical mesh) and read through the index buffer.
     let by_vertex = timings.time("weld", || shortcut::weld(&c, &tri.order, ng));
-    match by_vertex {
-        Some(of_vertex) => {
-            let w = ByVertex { of_vertex, idx: mesh.indices, order: &tri.order, identity: ng == n_faces };
-            Ok(finish(&c, &w, true, &mut tri.gwa, &mut tri.orient, &tri.order, ng, timings))
-        }
+    let (orient, gwa) = (std::mem::take(&mut tri.orient), std::mem::take(&mut tri.gwa));
+    Ok(match by_vertex {
+        Some(of_vertex) => finish(&c, ByVertex { of_vertex, idx: mesh.indices, order: &tri.order }, true, gwa, orient, &tri.order, ng, timings),
         None => {
             let w = timings.time("weld", || weld::weld(&c, &tri.order));
-            Ok(finish(&c, w.as_slice(), false, &mut tri.gwa, &mut tri.orient, &tri.order, ng, timings))
+            finish(&c, w, false, gwa, orient, &tri.order, ng, timings)
         }
-    }
+    })
 }
 
 /// Welded ids by internal corner (`3 t + j`, `t` in [`triangles::Triangles::order`]), for every
 /// corner of the mesh: degenerate triangles' corners come after the good ones.
 pub(crate) trait Welded: Sync {
     fn at(&self, k: usize) -> u32;
+    /// An input corner whose attributes have the same bits as the welded vertex of `k`'s.
+    #[inline]
+    fn attr_corner(&self, k: usize) -> usize {
+        self.at(k) as usize
+    }
 }
 
-impl Welded for [u32] {
+impl Welded for Vec<u32> {
     #[inline]
     fn at(&self, k: usize) -> u32 {
         self[k]
@@ -121,37 +125,47 @@ impl Welded for [u32] {
 struct ByVertex<'a> {
     of_vertex: Vec<u32>,
     idx: &'a [u32],
-    order: &'a [u32],
-    /// No degenerate triangles: the internal order is the input order.
-    identity: bool,
+    order: &'a Order,
+}
+
+impl ByVertex<'_> {
+    #[inline]
+    fn corner(&self, k: usize) -> usize {
+        3 * self.order.at(k / 3) as usize + k % 3
+    }
 }
 
 impl Welded for ByVertex<'_> {
     #[inline]
     fn at(&self, k: usize) -> u32 {
-        let id = if self.identity { k } else { 3 * self.order[k / 3] as usize + k % 3 };
-        self.of_vertex[self.idx[id] as usize]
+        self.of_vertex[self.idx[self.corner(k)] as usize]
+    }
+    /// The corner itself: the shortcut is only taken when every member of a class has the same
+    /// bits.
+    #[inline]
+    fn attr_corner(&self, k: usize) -> usize {
+        self.corner(k)
     }
 }
 
 /// The stages after the weld: adjacency, groups, sums, output.
 #[allow(clippy::too_many_arguments)]
-fn finish<W: Welded + ?Sized>(
+fn finish<W: Welded>(
     c: &Corners,
-    w: &W,
+    w: W,
     short_tail: bool,
-    gwa: &mut Vec<bool>,
-    orient: &mut [bool],
-    order: &[u32],
+    gwa: Vec<bool>,
+    mut orient: Vec<bool>,
+    order: &Order,
     ng: usize,
     timings: &mut crate::report::Timings,
 ) -> Frames {
     let n_faces = order.len();
-    let nb = timings.time("neighbors", || neighbors::build(w, 3 * ng, 3 * n_faces, short_tail));
+    let nb = timings.time("neighbors", || neighbors::build(&w, 3 * ng, 3 * n_faces, short_tail));
     crate::report::mem_mark("engine neighbors");
-    let mut grp = timings.time("groups", || groups::build(w, &nb, gwa, orient));
+    let mut grp = timings.time("groups", || groups::build(&w, &nb, &gwa, &mut orient));
     crate::report::mem_mark("engine groups");
-    drop(nb);
+    drop((nb, orient));
     // Sums are made a slice of groups at a time and kept compactly: one value for a group whose
     // members all got the same bits (the usual case), else one per member.
     let t_acc = std::time::Instant::now();
@@ -162,7 +176,7 @@ fn finish<W: Welded + ?Sized>(
     while g0 < n_groups {
         let limit = grp.start[g0] as usize + PASS;
         let g1 = (g0 + 1).max(grp.start.partition_point(|&x| (x as usize) <= limit) - 1).min(n_groups);
-        let vals = accumulate_all(c, w, order, gwa, &mut grp, g0..g1);
+        let vals = accumulate_all(c, &w, order, &gwa, &mut grp, g0..g1);
         let base = grp.start[g0] as usize;
         for g in g0..g1 {
             let v = &vals[grp.start[g] as usize - base..grp.start[g + 1] as usize - base];
@@ -180,19 +194,22 @@ fn finish<W: Welded + ?Sized>(
     timings.stages.push(("accumulate".into(), t_acc.elapsed().as_secs_f64() * 1e3));
     crate::report::mem_mark("engine accumulate");
     let t_out = std::time::Instant::now();
-    *gwa = Vec::new();
+    // Only what the scatter below needs stays: the welded ids only for degenerate triangles.
+    drop(gwa);
+    grp.orient = Vec::new();
+    let w = (ng < n_faces).then_some(w);
     // Filled in parallel: the first touch of each page (a page fault) is shared between threads.
     let mut slot: Vec<u32> = (0..c.mesh.indices.len()).into_par_iter().with_min_len(1 << 14).map(|_| NO_FRAME).collect();
     for g in 0..n_groups {
         let range = grp.start[g] as usize..grp.start[g + 1] as usize;
         let uniform = first_slot[g + 1] - first_slot[g] == 1;
         for (i, &k) in grp.members[range].iter().enumerate() {
-            let corner = 3 * order[(k / 3) as usize] as usize + (k % 3) as usize;
+            let corner = 3 * order.at((k / 3) as usize) as usize + (k % 3) as usize;
             slot[corner] = first_slot[g] + if uniform { 0 } else { i as u32 };
         }
     }
-    if ng < n_faces {
-        degenerate(w, order, ng, &mut slot);
+    if let Some(w) = w {
+        degenerate(&w, order, ng, &mut slot);
     }
     timings.stages.push(("output".into(), t_out.elapsed().as_secs_f64() * 1e3));
     Frames { slot, values }
@@ -204,11 +221,26 @@ const PASS: usize = 1 << 18;
 /// Runs [`accumulate::group_tangents`] on the groups in `groups`, in parallel batches of whole
 /// groups; returns their members' sums. Sorts each group's members (the reference sums in
 /// triangle order).
-fn accumulate_all<W: Welded + ?Sized>(c: &Corners, w: &W, order: &[u32], gwa: &[bool], grp: &mut groups::Groups, groups: std::ops::Range<usize>) -> Vec<V3> {
+fn accumulate_all<W: Welded>(c: &Corners, w: &W, order: &Order, gwa: &[bool], grp: &mut groups::Groups, groups: std::ops::Range<usize>) -> Vec<V3> {
     const BATCH: usize = 8192;
     let n_groups = groups.end;
     let (lo, hi) = (grp.start[groups.start] as usize, grp.start[groups.end] as usize);
     let mut vals = vec![[0.0f32; 3]; hi - lo];
+    // Each triangle's first-order vectors are needed by the groups of its three corners, which
+    // on a mesh with any locality fall in the same pass: computed once per pass for the span of
+    // triangles the pass reaches, unless that span is much wider than the pass.
+    let members = &grp.members[lo..hi];
+    let t_lo = members.par_iter().map(|&k| k / 3).min().unwrap_or(0) as usize;
+    let t_hi = members.par_iter().map(|&k| k / 3 + 1).max().unwrap_or(0) as usize;
+    let cache: Vec<(V3, V3)> = if t_hi - t_lo <= 2 * members.len() {
+        (t_lo..t_hi).into_par_iter().with_min_len(1 << 12).map(|t| triangles::first_order(c, order.at(t) as usize)).collect()
+    } else {
+        Vec::new()
+    };
+    let st = |t: usize| match cache.get(t.wrapping_sub(t_lo)) {
+        Some(&v) => v,
+        None => triangles::first_order(c, order.at(t) as usize),
+    };
     let mut batches = Vec::new();
     let mut rest_m = &mut grp.members[lo..hi];
     let mut rest_v = vals.as_mut_slice();
@@ -234,7 +266,7 @@ fn accumulate_all<W: Welded + ?Sized>(c: &Corners, w: &W, order: &[u32], gwa: &[
             let r = start[g] as usize - base..start[g + 1] as usize - base;
             let m = &mut ms[r.clone()];
             m.sort_unstable();
-            accumulate::group_tangents(c, w, order, gwa, w.at(m[0] as usize), m, &mut vs[r], &mut scratch);
+            accumulate::group_tangents(c, w, &st, gwa, w.at(m[0] as usize), m, &mut vs[r], &mut scratch);
         }
     });
     vals
@@ -242,8 +274,8 @@ fn accumulate_all<W: Welded + ?Sized>(c: &Corners, w: &W, order: &[u32], gwa: &[
 
 /// Corners of degenerate triangles copy the output of the first good corner (in the
 /// reference's good-triangle order) with the same welded id, if any.
-fn degenerate<W: Welded + ?Sized>(w: &W, order: &[u32], ng: usize, out: &mut [u32]) {
-    let corner = |k: usize| 3 * order[k / 3] as usize + k % 3;
+fn degenerate<W: Welded>(w: &W, order: &Order, ng: usize, out: &mut [u32]) {
+    let corner = |k: usize| 3 * order.at(k / 3) as usize + k % 3;
     let mut first_good = vec![u32::MAX; 3 * order.len()];
     for k in 0..3 * ng {
         let slot = &mut first_good[w.at(k) as usize];

@@ -21,6 +21,7 @@
 use super::math::canon_bits;
 use crate::scene::weld::{first_equal, hash_words};
 use super::Corners;
+use super::triangles::Order;
 use rayon::prelude::*;
 
 /// Beyond this many edges that could share the largest `i0`, replaying their buckets is not
@@ -30,7 +31,7 @@ const MAX_CANDIDATES: usize = 256;
 /// Welded ids as [`super::weld::weld`] gives them, up to the choice of representative within each
 /// class, per input vertex (every corner of a vertex has its vertex's id), or `None` when that choice could change the output (or the input has NaN or huge
 /// coordinates): the caller then replays the reference.
-pub(crate) fn weld(c: &Corners, order: &[u32], n_good: usize) -> Option<Vec<u32>> {
+pub(crate) fn weld(c: &Corners, order: &Order, n_good: usize) -> Option<Vec<u32>> {
     let idx = &c.mesh.indices[..3 * order.len()];
     let n_vertices = c.mesh.positions.len().min(c.mesh.normals.len()).min(c.mesh.uvs.len());
     // First and last corner id of each vertex (corner ids are 3 * face + j, in input order).
@@ -74,7 +75,7 @@ pub(crate) fn weld(c: &Corners, order: &[u32], n_good: usize) -> Option<Vec<u32>
         }
     }
     let class_of = |id: usize| class[idx[id] as usize] as usize;
-    let id_of = |k: usize| 3 * order[k / 3] as usize + k % 3;
+    let id_of = |k: usize| 3 * order.at(k / 3) as usize + k % 3;
     // Fewer than 3 edges can have the largest i0 (see the module comment).
     let bound = |k: usize| {
         let next = k - k % 3 + (k + 1) % 3;

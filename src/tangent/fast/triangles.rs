@@ -8,7 +8,7 @@ use rayon::prelude::*;
 /// Per-triangle state, indexed by the *internal* triangle index (position in [`Self::order`]).
 pub(crate) struct Triangles {
     /// Internal index -> input face index. The first `n_good` are non-degenerate.
-    pub order: Vec<u32>,
+    pub order: Order,
     pub n_good: usize,
     /// UV orientation (`signed area > 0`). Mutable: "group with anything" triangles take the
     /// orientation of the first group that reaches them.
@@ -24,14 +24,13 @@ fn degenerate(c: &Corners, f: usize) -> bool {
 }
 
 struct Info {
-    s: V3,
-    t: V3,
     orient: bool,
     gwa: bool,
 }
 
-/// `generate_triangle_info_list` of the reference, for one non-degenerate triangle.
-fn info(c: &Corners, f: usize) -> Info {
+/// The unnormalised first-order tangent and bitangent of face `f`, and twice its signed UV area.
+#[inline]
+fn raw(c: &Corners, f: usize) -> (V3, V3, f32) {
     let v = [c.pos(3 * f), c.pos(3 * f + 1), c.pos(3 * f + 2)];
     let tx = [c.uv(3 * f), c.uv(3 * f + 1), c.uv(3 * f + 2)];
     let d_tx = [
@@ -40,26 +39,54 @@ fn info(c: &Corners, f: usize) -> Info {
     ];
     let d_v = [sub(v[1], v[0]), sub(v[2], v[0])];
     let signed_area_double = d_tx[0][0] * d_tx[1][1] - d_tx[0][1] * d_tx[1][0];
-    let area_double = signed_area_double.abs();
     let s = sub(scale(d_tx[1][1], d_v[0]), scale(d_tx[0][1], d_v[1]));
     let t = {
         let a = scale(-d_tx[1][0], d_v[0]);
         let b = scale(d_tx[0][0], d_v[1]);
         [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
     };
-    let orient = signed_area_double > 0.0;
-    let mut out = Info { s: [0.0; 3], t: [0.0; 3], orient, gwa: true };
-    if not_zero(area_double) {
-        let sign = if orient { 1.0f32 } else { -1.0f32 };
-        out.s = scale(sign, normalized_or_zero(s));
-        out.t = scale(sign, normalized_or_zero(t));
-        let s_mag = length(s) / area_double;
-        let t_mag = length(t) / area_double;
-        if not_zero(s_mag) && not_zero(t_mag) {
-            out.gwa = false;
+    (s, t, signed_area_double)
+}
+
+/// `s` and `t` normalised and signed by the UV orientation, zero where the area vanishes.
+#[inline]
+fn signed_unit(s: V3, t: V3, signed_area_double: f32) -> (V3, V3) {
+    if not_zero(signed_area_double.abs()) {
+        let sign = if signed_area_double > 0.0 { 1.0f32 } else { -1.0f32 };
+        (scale(sign, normalized_or_zero(s)), scale(sign, normalized_or_zero(t)))
+    } else {
+        ([0.0; 3], [0.0; 3])
+    }
+}
+
+/// `generate_triangle_info_list` of the reference, for one non-degenerate triangle, less the
+/// first-order vectors ([`first_order`]).
+fn info(c: &Corners, f: usize) -> Info {
+    let (s, t, signed_area_double) = raw(c, f);
+    let area_double = signed_area_double.abs();
+    let gwa = !(not_zero(area_double) && not_zero(length(s) / area_double) && not_zero(length(t) / area_double));
+    Info { orient: signed_area_double > 0.0, gwa }
+}
+
+/// The reference's triangle order: internal index -> input face. Not stored when no triangle is
+/// degenerate (the order is then the input's).
+pub(crate) struct Order {
+    faces: Vec<u32>,
+    n: usize,
+}
+
+impl Order {
+    #[inline]
+    pub(crate) fn at(&self, t: usize) -> u32 {
+        if self.faces.is_empty() {
+            t as u32
+        } else {
+            self.faces[t]
         }
     }
-    out
+    pub(crate) fn len(&self) -> usize {
+        self.n
+    }
 }
 
 impl Triangles {
@@ -67,15 +94,19 @@ impl Triangles {
         let n_faces = c.n_faces();
         let degen: Vec<bool> = (0..n_faces).into_par_iter().map(|f| degenerate(c, f)).collect();
         let n_good = degen.iter().filter(|&&d| !d).count();
-        let mut order = Vec::with_capacity(n_faces);
-        order.extend((0..n_faces).filter(|&f| !degen[f]).map(|f| f as u32));
-        order.extend((0..n_faces).filter(|&f| degen[f]).map(|f| f as u32));
+        let mut faces = Vec::new();
+        if n_good < n_faces {
+            faces.reserve_exact(n_faces);
+            faces.extend((0..n_faces).filter(|&f| !degen[f]).map(|f| f as u32));
+            faces.extend((0..n_faces).filter(|&f| degen[f]).map(|f| f as u32));
+        }
+        let order = Order { faces, n: n_faces };
         // The first-order vectors are not kept (24 bytes a triangle, the engine's largest
         // array): the sums recompute them from the corners, which costs less than the memory.
-        let (orient, gwa): (Vec<bool>, Vec<bool>) = order[..n_good]
-            .par_iter()
-            .map(|&f| {
-                let i = info(c, f as usize);
+        let (orient, gwa): (Vec<bool>, Vec<bool>) = (0..n_good)
+            .into_par_iter()
+            .map(|t| {
+                let i = info(c, order.at(t) as usize);
                 (i.orient, i.gwa)
             })
             .unzip();
@@ -88,6 +119,6 @@ impl Triangles {
 /// the same every time.
 #[inline]
 pub(crate) fn first_order(c: &Corners, f: usize) -> (V3, V3) {
-    let i = info(c, f);
-    (i.s, i.t)
+    let (s, t, a) = raw(c, f);
+    signed_unit(s, t, a)
 }

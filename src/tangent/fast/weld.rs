@@ -13,6 +13,7 @@
 
 use super::math::{canon_bits, eq3, V3};
 use super::Corners;
+use super::triangles::Order;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -124,13 +125,13 @@ impl Buckets {
 }
 
 /// Positions in list order, gathered once.
-fn list_positions(c: &Corners, order: &[u32]) -> Vec<V3> {
-    (0..order.len() * 3).into_par_iter().with_min_len(1 << 12).map(|k| c.pos(3 * order[k / 3] as usize + k % 3)).collect()
+fn list_positions(c: &Corners, order: &Order) -> Vec<V3> {
+    (0..order.len() * 3).into_par_iter().with_min_len(1 << 12).map(|k| c.pos(3 * order.at(k / 3) as usize + k % 3)).collect()
 }
 
 /// The welded id [`weld`] gives list entries `ks`, replaying only the buckets they fall in.
-pub(crate) fn welded_of(c: &Corners, order: &[u32], ks: &[usize]) -> Vec<u32> {
-    let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
+pub(crate) fn welded_of(c: &Corners, order: &Order, ks: &[usize]) -> Vec<u32> {
+    let id_of = |k: usize| 3 * order.at(k / 3) + (k % 3) as u32;
     let pos_of = |k: usize| c.pos(id_of(k) as usize);
     let n = order.len() * 3;
     let Some(bk) = Buckets::new(n, pos_of) else { return Vec::new() };
@@ -170,9 +171,9 @@ pub(crate) fn welded_of(c: &Corners, order: &[u32], ks: &[usize]) -> Vec<u32> {
 
 /// Returns, for each list entry `k` (3 per internal triangle, good triangles first), the input
 /// corner id of its welded representative.
-pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
+pub(crate) fn weld(c: &Corners, order: &Order) -> Vec<u32> {
     let n = order.len() * 3;
-    let id_of = |k: usize| 3 * order[k / 3] + (k % 3) as u32;
+    let id_of = |k: usize| 3 * order.at(k / 3) + (k % 3) as u32;
     let pos = list_positions(c, order);
     let mut welded: Vec<u32> = (0..n).into_par_iter().with_min_len(1 << 12).map(id_of).collect();
     let Some(bk) = Buckets::new(pos.len(), |k| pos[k]) else { return welded };
@@ -234,7 +235,7 @@ pub(crate) fn weld(c: &Corners, order: &[u32]) -> Vec<u32> {
 /// `merge_verts_fast` of the reference with an explicit stack. Each cell's bounding box is
 /// gathered while its parent is partitioned (min/max ignore NaN and the order of folding; the
 /// sign of a zero bound can differ but never changes a comparison the reference makes).
-fn merge(c: &Corners, order: &[u32], buf: &mut [Tmp], reps: &mut [u32]) {
+fn merge(c: &Corners, order: &Order, buf: &mut [Tmp], reps: &mut [u32]) {
     let mut bbox = EMPTY;
     buf.iter().for_each(|t| bbox.grow(t.p));
     let mut stack = vec![(0usize, buf.len(), bbox)];
@@ -320,10 +321,10 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
 const SMALL_LEAF: usize = 24;
 
 /// Welds every corner of a leaf onto the first equal corner in leaf order.
-fn leaf(c: &Corners, order: &[u32], b: &[Tmp], reps: &mut [u32], attrs: &mut Vec<(u32, [f32; 3], [f32; 2])>) {
+fn leaf(c: &Corners, order: &Order, b: &[Tmp], reps: &mut [u32], attrs: &mut Vec<(u32, [f32; 3], [f32; 2])>) {
     attrs.clear();
     attrs.extend(b.iter().map(|t| {
-        let id = 3 * order[t.k as usize / 3] + t.k % 3;
+        let id = 3 * order.at(t.k as usize / 3) + t.k % 3;
         (id, c.nrm(id as usize), c.uv(id as usize))
     }));
     if b.len() <= SMALL_LEAF {
