@@ -49,47 +49,64 @@ pub(crate) fn build<W: Welded + ?Sized>(w: &W, n_edges: usize, id_space: usize, 
         }
         s
     };
-    let per_chunk: Vec<Vec<Vec<u32>>> = (0..n_edges.div_ceil(CHUNK))
+    // One flat array, range after range, each range's edges in triangle order: counted per
+    // chunk, then written by the chunks in parallel into their own slices. One allocation, freed
+    // whole when the pairing is done.
+    let n_chunks = n_edges.div_ceil(CHUNK);
+    let chunk = |ch: usize| ch * CHUNK..n_edges.min((ch + 1) * CHUNK);
+    let range_of = |e: usize| {
+        let k = i0_of(w, e);
+        (!(replay && k == max_i0)).then_some((k >> shift) as usize)
+    };
+    let counts: Vec<Vec<usize>> = (0..n_chunks)
         .into_par_iter()
         .map(|ch| {
-            let mut v: Vec<Vec<u32>> = vec![Vec::new(); RANGES];
-            for e in ch * CHUNK..n_edges.min((ch + 1) * CHUNK) {
-                let k = i0_of(w, e);
-                if !(replay && k == max_i0) {
-                    v[(k >> shift) as usize].push(e as u32);
-                }
-            }
-            v
+            let mut n = vec![0usize; RANGES];
+            chunk(ch).filter_map(range_of).for_each(|r| n[r] += 1);
+            n
         })
         .collect();
-    // Regroup the chunks' lists by range (moves, no copies), then pair the ranges a wave at a
-    // time: each wave's lists are freed as it is paired and its pairs linked before the next,
-    // so neither all edges twice nor all pairs are ever held at once.
-    let mut by_range: Vec<Vec<Vec<u32>>> = (0..RANGES).map(|_| Vec::with_capacity(per_chunk.len())).collect();
-    for chunk in per_chunk {
-        for (r, list) in chunk.into_iter().enumerate() {
-            by_range[r].push(list);
+    let total: usize = counts.iter().flatten().sum();
+    let mut flat = vec![0u32; total];
+    let mut range_start = vec![0usize; RANGES + 1];
+    {
+        let mut slices: Vec<Vec<&mut [u32]>> = (0..n_chunks).map(|_| Vec::with_capacity(RANGES)).collect();
+        let mut rest = flat.as_mut_slice();
+        for r in 0..RANGES {
+            for ch in 0..n_chunks {
+                let (head, tail) = std::mem::take(&mut rest).split_at_mut(counts[ch][r]);
+                slices[ch].push(head);
+                rest = tail;
+            }
+            range_start[r + 1] = range_start[r] + counts.iter().map(|c| c[r]).sum::<usize>();
         }
+        slices.into_par_iter().enumerate().for_each(|(ch, mut out)| {
+            let mut at = vec![0usize; RANGES];
+            for e in chunk(ch) {
+                if let Some(r) = range_of(e) {
+                    out[r][at[r]] = e as u32;
+                    at[r] += 1;
+                }
+            }
+        });
     }
+    // Ranges are paired a wave at a time and each wave's pairs linked before the next, so all
+    // pairs are never held at once.
     let mut link = |a: u32, b: u32| {
         nb[a as usize] = b / 3;
         nb[b as usize] = a / 3;
     };
     const WAVE: usize = 16;
     for w0 in (0..RANGES).step_by(WAVE) {
-        let wave: Vec<Vec<Vec<u32>>> = by_range[w0..w0 + WAVE].iter_mut().map(std::mem::take).collect();
-        let pairs: Vec<Vec<(u32, u32)>> = wave
+        let pairs: Vec<Vec<(u32, u32)>> = (w0..w0 + WAVE)
             .into_par_iter()
-            .enumerate()
-            .map(|(i, lists)| {
-                let edges: Vec<u32> = lists.into_iter().flatten().collect();
-                pair_range(w, &edges, ((w0 + i) as u32) << shift, 1usize << shift)
-            })
+            .map(|r| pair_range(w, &flat[range_start[r]..range_start[r + 1]], (r as u32) << shift, 1usize << shift))
             .collect();
         for (a, b) in pairs.into_iter().flatten() {
             link(a, b);
         }
     }
+    drop(flat);
     if replay {
         let tail = legacy_tail(w, n_edges, max_i0);
         // Runs of equal i1, each sorted by triangle, except the last run (the off-by-one).
@@ -118,23 +135,28 @@ fn pair_range<W: Welded + ?Sized>(w: &W, edges: &[u32], base: u32, span: usize) 
     if edges.len() < 2 {
         return out;
     }
-    // Counting sort by i0 within the range (stable).
+    // Counting sort by i0 within the range (stable), each key read once.
+    let keys: Vec<u32> = edges.iter().map(|&e| i0_of(w, e as usize) - base).collect();
     let mut start = vec![0u32; span + 1];
-    for &e in edges {
-        start[(i0_of(w, e as usize) - base) as usize + 1] += 1;
+    for &k in &keys {
+        start[k as usize + 1] += 1;
     }
     for i in 0..span {
         start[i + 1] += start[i];
     }
-    let mut sorted = vec![0u32; edges.len()];
-    for &e in edges {
-        let c = &mut start[(i0_of(w, e as usize) - base) as usize];
-        sorted[*c as usize] = e;
+    let mut sorted = vec![(0u32, 0u32); edges.len()];
+    for (&e, &k) in edges.iter().zip(&keys) {
+        let c = &mut start[k as usize];
+        sorted[*c as usize] = (k, e);
         *c += 1;
     }
+    drop(keys);
     let mut scratch: Vec<(u32, u32)> = Vec::new();
-    for bucket in sorted.chunk_by(|&a, &b| i0_of(w, a as usize) == i0_of(w, b as usize)) {
-        pair_bucket(w, bucket, &mut scratch, &mut |a, b| out.push((a, b)));
+    let mut bucket: Vec<u32> = Vec::new();
+    for run in sorted.chunk_by(|a, b| a.0 == b.0) {
+        bucket.clear();
+        bucket.extend(run.iter().map(|x| x.1));
+        pair_bucket(w, &bucket, &mut scratch, &mut |a, b| out.push((a, b)));
     }
     out
 }
