@@ -105,7 +105,7 @@ pub fn any_orthogonal(n: Vec3) -> Vec3 {
 #[derive(Debug, Clone, Copy)]
 pub struct CornerNormals<'a> {
     pub normals: &'a [[f32; 3]],
-    /// Corner -> index into `normals`.
+    /// Corner -> index into `normals`: also the index list the frames were made for.
     pub normal_of: &'a [u32],
     /// Corner -> vertex: corners of one vertex lend to each other.
     pub vertex: &'a [u32],
@@ -118,17 +118,17 @@ pub fn repair(frames: &mut Frames, at: CornerNormals) -> FallbackCounts {
     let mut counts = FallbackCounts::default();
     // Unit normals, once per normal rather than once per corner.
     let units: Vec<Option<Vec3>> = at.normals.par_iter().with_min_len(1 << 12).map(|&n| unit(Vec3::from(n))).collect();
-    let ok = |c: usize| frames.get(c).is_some_and(|t| is_valid_unit(t, units[at.normal_of[c] as usize]));
-    let bad: Vec<usize> = (0..frames.len()).into_par_iter().with_min_len(1 << 12).filter(|&c| !ok(c)).collect();
+    let ok = |c: usize| frames.get(c, at.normal_of[c]).is_some_and(|t| is_valid_unit(t, units[at.normal_of[c] as usize]));
+    let bad: Vec<usize> = (0..at.normal_of.len()).into_par_iter().with_min_len(1 << 12).filter(|&c| !ok(c)).collect();
     if bad.is_empty() {
         return counts;
     }
-    let mut bad_flag = vec![false; frames.len()];
+    let mut bad_flag = vec![false; at.normal_of.len()];
     bad.iter().for_each(|&c| bad_flag[c] = true);
     // First valid corner of each vertex, to lend from across triangles.
     let n_vertices = at.vertex.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
     let mut by_vertex = vec![usize::MAX; n_vertices];
-    for c in 0..frames.len() {
+    for c in 0..at.normal_of.len() {
         let v = at.vertex[c] as usize;
         if by_vertex[v] == usize::MAX && !bad_flag[c] {
             by_vertex[v] = c;
@@ -137,7 +137,7 @@ pub fn repair(frames: &mut Frames, at: CornerNormals) -> FallbackCounts {
     // Only valid corners lend and only invalid ones change, so the order of repairs is free.
     let mut repaired = Vec::with_capacity(bad.len());
     for &c in &bad {
-        let original = frames.get(c);
+        let original = frames.get(c, at.normal_of[c]);
         match original {
             Some(_) => counts.invalid += 1,
             None => counts.undefined += 1,
@@ -145,7 +145,7 @@ pub fn repair(frames: &mut Frames, at: CornerNormals) -> FallbackCounts {
         let n = Vec3::from(at.normals[at.normal_of[c] as usize]);
         let tri = c / 3 * 3;
         let lenders = (tri..tri + 3).filter(|&k| k != c && !bad_flag[k]).chain(Some(by_vertex[at.vertex[c] as usize]).filter(|&k| k != usize::MAX));
-        let chosen = lenders.filter_map(|k| frames.get(k)).find_map(|t| orthogonalise(Vec3::new(t[0], t[1], t[2]), n).map(|v| [v.x, v.y, v.z, t[3]]));
+        let chosen = lenders.filter_map(|k| frames.get(k, at.normal_of[k])).find_map(|t| orthogonalise(Vec3::new(t[0], t[1], t[2]), n).map(|v| [v.x, v.y, v.z, t[3]]));
         repaired.push(match chosen {
             Some(f) => {
                 counts.borrowed += 1;
@@ -170,11 +170,11 @@ mod tests {
 
     /// `repair` on frames with `None` as `w = 0`, one normal per corner.
     fn fix(f: &[Option<[f32; 4]>], normals: &[Vec3], vertex: &[u32]) -> (Vec<[f32; 4]>, FallbackCounts) {
-        let mut frames = Frames::from_flat(f.iter().map(|t| t.unwrap_or([0.0; 4])).collect());
         let n: Vec<[f32; 3]> = normals.iter().map(|v| v.to_array()).collect();
         let ids: Vec<u32> = (0..n.len() as u32).collect();
+        let mut frames = Frames::from_flat(&ids, f.iter().map(|t| t.unwrap_or([0.0; 4])).collect());
         let c = repair(&mut frames, CornerNormals { normals: &n, normal_of: &ids, vertex });
-        (frames.to_flat(), c)
+        (frames.to_flat(&ids), c)
     }
 
     #[test]

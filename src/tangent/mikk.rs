@@ -1,7 +1,8 @@
-//! The MikkTSpace engine boundary. Everything above this file sees per-corner frames ([`Frames`]); only this
-//! file knows which implementation produced them, so a faster one can replace it.
+//! The MikkTSpace engine boundary. Everything above this file sees per-corner frames
+//! ([`Frames`]); only this file knows which implementation produced them, so a faster one can
+//! replace it.
 
-use super::frames::{Frames, NO_FRAME};
+use super::frames::Frames;
 use super::TriMesh;
 
 /// Which implementation computes the reference frames.
@@ -23,13 +24,13 @@ pub fn generate(mesh: &TriMesh, engine: Engine) -> Vec<Option<[f32; 4]>> {
 
 /// [`generate`] as flat frames, `[0.0; 4]` (`w == 0`) where it gives `None`.
 pub fn frames(mesh: &TriMesh, engine: Engine) -> Vec<[f32; 4]> {
-    compact(mesh, engine).to_flat()
+    compact(mesh, engine).to_flat(mesh.indices)
 }
 
 /// [`generate`] as [`Frames`]: each value once per group of corners the engine shares it among
-/// (the fast engine), or once per corner (the reference).
+/// (the fast engine), or once per corner (the reference), found through `mesh.indices`.
 pub fn compact(mesh: &TriMesh, engine: Engine) -> Frames {
-    let bevy = |mesh: &TriMesh| Frames::from_flat(generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect());
+    let bevy = |mesh: &TriMesh| Frames::from_flat(mesh.indices, generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect());
     match engine {
         Engine::Bevy => bevy(mesh),
         Engine::Fast => match super::fast::generate(mesh) {
@@ -37,7 +38,7 @@ pub fn compact(mesh: &TriMesh, engine: Engine) -> Frames {
             // Beyond 32-bit corner ids: the reference has no such limit.
             Err(super::fast::Unsupported::TooLarge) => bevy(mesh),
             // An index past an attribute array: no frame is defined (the reference panics).
-            Err(super::fast::Unsupported::IndexOutOfRange) => Frames { slot: vec![NO_FRAME; mesh.indices.len()], values: Vec::new() },
+            Err(super::fast::Unsupported::IndexOutOfRange) => Frames::none(mesh.indices),
         },
     }
 }

@@ -80,14 +80,14 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
     let generated_normals = p.attr("NORMAL").is_none();
-    let corner_ids: Vec<u32>;
+    let (corner_ids, cp, cu, flat): (Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[f32; 3]>);
     let (normals, normal_of, mut frames) = if generated_normals {
-        let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
-        let (n, _) = flat_normals(&cp);
-        let cu: Vec<[f32; 2]> = p.indices.iter().map(|&i| uvs[i as usize]).collect();
+        cp = p.indices.iter().map(|&i| positions[i as usize]).collect();
+        flat = flat_normals(&cp).0;
+        cu = p.indices.iter().map(|&i| uvs[i as usize]).collect();
         corner_ids = (0..p.indices.len() as u32).collect();
-        let frames = generate_with_stack(&TriMesh { positions: &cp, normals: &n, uvs: &cu, indices: &corner_ids }, opts.engine);
-        (n.into(), corner_ids.as_slice(), frames)
+        let frames = generate_with_stack(&TriMesh { positions: &cp, normals: &flat, uvs: &cu, indices: &corner_ids }, opts.engine);
+        (flat.as_slice().into(), corner_ids.as_slice(), frames)
     } else {
         let n = p.attr("NORMAL").map(|s| s.as_f32()).unwrap_or_default();
         let frames = generate_with_stack(&TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices }, opts.engine);
@@ -104,7 +104,7 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
 
     // Every corner has a frame now. Tangents and bitangents are read through the compact frames,
     // never spelt out per corner.
-    let tangent = |c: usize| frames.get(c).unwrap_or([0.0; 4]);
+    let tangent = |c: usize| frames.get(c, normal_of[c]).unwrap_or([0.0; 4]);
     let bitangent = |c: usize| {
         let t = tangent(c);
         let b = Vec3::from(normals[normal_of[c] as usize]).normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3];

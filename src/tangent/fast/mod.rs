@@ -27,7 +27,7 @@ mod shortcut;
 mod triangles;
 mod weld;
 
-use super::frames::{Frames, NO_FRAME};
+use super::frames::{Builder, Frames};
 use triangles::Order;
 use super::TriMesh;
 use math::V3;
@@ -86,7 +86,7 @@ pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::report::Timings) -> R
     }
     let c = Corners { mesh };
     if n_faces == 0 {
-        return Ok(Frames { slot: vec![NO_FRAME; mesh.indices.len()], values: Vec::new() });
+        return Ok(Frames::none(mesh.indices));
     }
     let mut tri = timings.time("triangles", || triangles::Triangles::build(&c));
     let ng = tri.n_good;
@@ -95,10 +95,10 @@ pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::report::Timings) -> R
     let by_vertex = timings.time("weld", || shortcut::weld(&c, &tri.order, ng));
     let (orient, gwa) = (std::mem::take(&mut tri.orient), std::mem::take(&mut tri.gwa));
     Ok(match by_vertex {
-        Some(of_vertex) => finish(&c, ByVertex { of_vertex, idx: mesh.indices, order: &tri.order }, true, gwa, orient, &tri.order, ng, timings),
+        Some(of_vertex) => finish(&c, mesh.indices, ByVertex { of_vertex, idx: mesh.indices, order: &tri.order }, true, gwa, orient, &tri.order, ng, timings),
         None => {
             let w = timings.time("weld", || weld::weld(&c, &tri.order));
-            finish(&c, w, false, gwa, orient, &tri.order, ng, timings)
+            finish(&c, mesh.indices, w, false, gwa, orient, &tri.order, ng, timings)
         }
     })
 }
@@ -152,6 +152,7 @@ impl Welded for ByVertex<'_> {
 #[allow(clippy::too_many_arguments)]
 fn finish<W: Welded>(
     c: &Corners,
+    idx: &[u32],
     w: W,
     short_tail: bool,
     gwa: Vec<bool>,
@@ -198,21 +199,22 @@ fn finish<W: Welded>(
     drop(gwa);
     grp.orient = Vec::new();
     let w = (ng < n_faces).then_some(w);
-    // Filled in parallel: the first touch of each page (a page fault) is shared between threads.
-    let mut slot: Vec<u32> = (0..c.mesh.indices.len()).into_par_iter().with_min_len(1 << 14).map(|_| NO_FRAME).collect();
+    let mut out = Builder::new(idx);
     for g in 0..n_groups {
         let range = grp.start[g] as usize..grp.start[g + 1] as usize;
         let uniform = first_slot[g + 1] - first_slot[g] == 1;
         for (i, &k) in grp.members[range].iter().enumerate() {
             let corner = 3 * order.at((k / 3) as usize) as usize + (k % 3) as usize;
-            slot[corner] = first_slot[g] + if uniform { 0 } else { i as u32 };
+            out.put(corner, first_slot[g] + if uniform { 0 } else { i as u32 });
         }
     }
+    drop(grp);
     if let Some(w) = w {
-        degenerate(&w, order, ng, &mut slot);
+        degenerate(&w, order, ng, &mut out);
     }
+    let frames = out.finish(values);
     timings.stages.push(("output".into(), t_out.elapsed().as_secs_f64() * 1e3));
-    Frames { slot, values }
+    frames
 }
 
 /// Members per pass of the sums (see [`generate_timed`]).
@@ -274,7 +276,7 @@ fn accumulate_all<W: Welded>(c: &Corners, w: &W, order: &Order, gwa: &[bool], gr
 
 /// Corners of degenerate triangles copy the output of the first good corner (in the
 /// reference's good-triangle order) with the same welded id, if any.
-fn degenerate<W: Welded>(w: &W, order: &Order, ng: usize, out: &mut [u32]) {
+fn degenerate<W: Welded>(w: &W, order: &Order, ng: usize, out: &mut Builder) {
     let corner = |k: usize| 3 * order.at(k / 3) as usize + k % 3;
     let mut first_good = vec![u32::MAX; 3 * order.len()];
     for k in 0..3 * ng {
@@ -285,8 +287,8 @@ fn degenerate<W: Welded>(w: &W, order: &Order, ng: usize, out: &mut [u32]) {
     }
     for k in 3 * ng..3 * order.len() {
         let src = first_good[w.at(k) as usize];
-        if src != u32::MAX {
-            out[corner(k)] = out[corner(src as usize)];
+        if let Some(slot) = (src != u32::MAX).then(|| out.slot(corner(src as usize))).flatten() {
+            out.put(corner(k), slot);
         }
     }
 }

@@ -130,7 +130,7 @@ fn the_weld_shortcut_finds_the_replayed_classes_and_is_taken_on_plain_meshes() {
     let tri = super::triangles::Triangles::build(&c);
     let of_vertex = super::shortcut::weld(&c, &tri.order, tri.n_good).expect("a plain grid takes the shortcut");
     // Per vertex, read through the index buffer as the engine does.
-    let w = super::ByVertex { of_vertex, idx: &idx, order: &tri.order, identity: tri.n_good == tri.order.len() };
+    let w = super::ByVertex { of_vertex, idx: &idx, order: &tri.order };
     let short: Vec<u32> = (0..idx.len()).map(|k| super::Welded::at(&w, k)).collect();
     let replayed = super::weld::weld(&c, &tri.order);
     assert_eq!(classes(&short), classes(&replayed));
