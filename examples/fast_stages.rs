@@ -29,7 +29,7 @@ fn main() {
                 (s1.0 - s0.0) as f64 * 1e-6,
                 (s1.1 - s0.1) as f64 * 1e-6,
                 stages.join(", "),
-                out.len()
+                out.values.len()
             );
         }
     });

@@ -3,6 +3,7 @@
 mod bake;
 mod bench;
 mod bench_batch;
+mod bench_command;
 mod bench_normalmap;
 mod bench_tangents;
 mod completions;

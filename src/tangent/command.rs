@@ -47,6 +47,7 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
         files.add(d, crate::output::depfile(&[&job.output], &scene.dependencies()));
     }
     t.time("write", || files.commit())?;
+    crate::report::mem_mark("write");
     Ok(summarise(&job.input, &job.output, prims, scene.notes, written, t))
 }
 
