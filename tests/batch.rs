@@ -98,3 +98,24 @@ fn validate_batch_goes_on_past_an_unusable_file() {
     assert_eq!(rep["files"].as_array().unwrap().len(), 2, "both good files are reported: {rep}");
     assert!(String::from_utf8_lossy(&o.stderr).contains("bad.glb"));
 }
+
+#[test]
+#[cfg(target_os = "linux")] // peak memory is read from /proc
+fn bench_command_reports_the_whole_commands_time_and_peak_memory() {
+    let input = fixture("khronos/NormalTangentTest.glb");
+    let o = run(&["bench", "command", s(&input), "--runs", "2", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["runs"], 2);
+    assert_eq!(r["input_bytes"], std::fs::metadata(&input).unwrap().len());
+    // The output is the input with tangents (it has none): larger.
+    assert!(r["output_bytes"].as_u64().unwrap() > r["input_bytes"].as_u64().unwrap());
+    let peak = r["peak_kib"].as_u64().unwrap();
+    assert!(peak > 1000, "a process's resident set is megabytes, not {peak} KiB");
+    let ratio = r["peak_over_input"].as_f64().unwrap();
+    assert!((ratio - peak as f64 * 1024.0 / r["input_bytes"].as_f64().unwrap()).abs() < 1e-9);
+    assert!(r["min_s"].as_f64().unwrap() <= r["median_s"].as_f64().unwrap());
+    // A file that is not a mesh is the command's error, reported as one line.
+    let bad = run(&["bench", "command", s(&fixture("khronos/NormalTangentTest.mesh0.prim0.tangents.txt")), "--runs", "1"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

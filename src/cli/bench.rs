@@ -1,7 +1,8 @@
 //! `bumpbake bench ...`: error against run time for each stage.
 
 use super::{bench_batch, bench_command, bench_normalmap, bench_tangents};
-use bumpbake::Result;
+use bumpbake::{Error, Result};
+use std::path::Path;
 use clap::Subcommand;
 
 #[derive(clap::Args, Debug)]
@@ -32,5 +33,24 @@ pub fn run(args: Args) -> Result<u8> {
         What::Tangents(a) => bench_tangents::run(a),
         What::Batch(a) => bench_batch::run(a),
         What::Command(a) => bench_command::run(a),
+    }
+}
+
+/// Runs `f(bumpbake's own executable, a scratch folder)` for benchmark `what`, then removes the
+/// folder.
+pub(super) fn with_scratch<T>(what: &str, f: impl FnOnce(&Path, &Path) -> Result<T>) -> Result<T> {
+    let exe = std::env::current_exe().map_err(|e| Error::usage(format!("bench {what}: cannot find bumpbake itself: {e}")))?;
+    let dir = std::env::temp_dir().join(format!("bumpbake-bench-{what}-{}", std::process::id()));
+    let r = f(&exe, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    r
+}
+
+/// Prints `r` as JSON, or as `text(r)`.
+pub(super) fn print<T: serde::Serialize>(r: &T, json: bool, text: impl FnOnce(&T) -> String) {
+    if json {
+        println!("{}", serde_json::to_string_pretty(r).expect("serialises"));
+    } else {
+        println!("{}", text(r));
     }
 }

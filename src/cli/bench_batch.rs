@@ -1,6 +1,6 @@
 //! `bumpbake bench batch`: a batch of small assets through `bake -j N` against one process each.
 
-use bumpbake::{Error, Result};
+use bumpbake::Result;
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
@@ -22,18 +22,12 @@ pub struct BenchBatchArgs {
 }
 
 pub fn run(a: BenchBatchArgs) -> Result<u8> {
-    let exe = std::env::current_exe().map_err(|e| Error::usage(format!("bench batch: cannot find bumpbake itself: {e}")))?;
-    let dir = std::env::temp_dir().join(format!("bumpbake-bench-batch-{}", std::process::id()));
-    let r = bumpbake::bench::batch::run(&exe, &dir, a.assets, a.jobs, a.runs);
-    let _ = std::fs::remove_dir_all(&dir);
-    let r = r?;
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&r).expect("serialises"));
-    } else {
-        println!(
+    let r = super::bench::with_scratch("batch", |exe, dir| bumpbake::bench::batch::run(exe, dir, a.assets, a.jobs, a.runs))?;
+    super::bench::print(&r, a.json, |r| {
+        format!(
             "{} assets: one process each {:.0} ms, one batch with -j {} {:.0} ms (medians of {}): ratio {:.2} (target <= 0.6)",
             r.assets, r.one_by_one_ms, r.jobs, r.batch_ms, r.runs, r.ratio
-        );
-    }
+        )
+    });
     Ok(0)
 }

@@ -1,6 +1,6 @@
 //! `bumpbake bench command`: the whole `tangents` command on a file, time and peak memory.
 
-use bumpbake::{Error, Result};
+use bumpbake::Result;
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -19,15 +19,9 @@ pub struct BenchCommandArgs {
 }
 
 pub fn run(a: BenchCommandArgs) -> Result<u8> {
-    let exe = std::env::current_exe().map_err(|e| Error::usage(format!("bench command: cannot find bumpbake itself: {e}")))?;
-    let dir = std::env::temp_dir().join(format!("bumpbake-bench-command-{}", std::process::id()));
-    let r = bumpbake::bench::command::run(&exe, &a.input, &dir, a.runs);
-    let _ = std::fs::remove_dir_all(&dir);
-    let r = r?;
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&r).expect("serialises"));
-    } else {
-        println!(
+    let r = super::bench::with_scratch("command", |exe, dir| bumpbake::bench::command::run(exe, &a.input, dir, a.runs))?;
+    super::bench::print(&r, a.json, |r| {
+        format!(
             "tangents {} ({:.1} MB) -> {:.1} MB: median {:.2} s (min {:.2}, max {:.2}, {} runs); peak memory {:.1} MB = {:.2}x the input (target < 3)",
             r.input.display(),
             r.input_bytes as f64 / 1e6,
@@ -38,7 +32,7 @@ pub fn run(a: BenchCommandArgs) -> Result<u8> {
             r.runs,
             r.peak_kib as f64 * 1024.0 / 1e6,
             r.peak_over_input
-        );
-    }
+        )
+    });
     Ok(0)
 }
