@@ -15,7 +15,12 @@
 //! 3. [`neighbors`]: triangle adjacency, including the legacy sort's unpaired tail;
 //! 4. [`groups`]: orientation-consistent fans around each welded vertex;
 //! 5. [`accumulate`]: sub-groups by the angular threshold and angle-weighted sums;
-//! 6. here: degenerate triangles borrow from the first good corner of the same welded vertex.
+//! 6. here: degenerate triangles borrow from the first good corner of the same welded vertex,
+//!    and the output is [`Frames`]: each summed value once, found through the vertex.
+//!
+//! At its peak the engine holds, beside its input, the adjacency and its edge list (a `u32` per
+//! corner each): nothing else per triangle or per corner is kept that a later stage can recompute
+//! or read through the index buffer.
 
 #![forbid(unsafe_code)]
 
