@@ -212,47 +212,56 @@ impl SplitPlan {
         // The class of each vertex: the first byte-identical vertex.
         let class = first_equal(&hashes, |a, b| vertex_streams.iter().all(|s| s.elem(a) == s.elem(b)));
         drop(hashes);
-        let same = |a: usize, b: usize| extra.iter().all(|s| s.get(a)[..s.width()].iter().zip(&s.get(b)).all(|(x, y)| x.to_bits() == y.to_bits()));
+        // Each corner's added values are read once; a vertex's are kept as it is made (they are
+        // the added streams), and later corners compare against those bytes.
+        let widths: Vec<usize> = extra.iter().map(|s| s.width()).collect();
+        let mut data: Vec<Vec<u8>> = widths.iter().map(|w| Vec::with_capacity(n_vertices * w * 4)).collect();
+        let mut cur = vec![[0.0f32; 4]; extra.len()];
+        let same = |data: &[Vec<u8>], cur: &[[f32; 4]], m: u32| {
+            data.iter().zip(cur).zip(&widths).all(|((d, v), &w)| {
+                d[m as usize * w * 4..][..w * 4].chunks_exact(4).zip(&v[..w]).all(|(b, x)| b == x.to_le_bytes())
+            })
+        };
         let mut made_first = vec![u32::MAX; n_vertices];
         let mut made_more: HashMap<u32, Vec<u32>, BuildHasherDefault<Fx>> = HashMap::default();
-        let mut order: Vec<u32> = Vec::new();
+        let mut origins: Vec<u32> = Vec::new();
         let mut indices = Vec::with_capacity(corners);
         for c in 0..corners {
+            for (v, s) in cur.iter_mut().zip(extra) {
+                *v = s.get(c);
+            }
             let v = class[base.indices[c] as usize];
             let first = made_first[v as usize];
-            let m = if first == u32::MAX {
-                made_first[v as usize] = order.len() as u32;
-                order.push(c as u32);
-                order.len() as u32 - 1
-            } else if same(order[first as usize] as usize, c) {
-                first
+            let found = if first == u32::MAX {
+                None
+            } else if same(&data, &cur, first) {
+                Some(first)
             } else {
-                let more = made_more.entry(v).or_default();
-                match more.iter().copied().find(|&m| same(order[m as usize] as usize, c)) {
-                    Some(m) => m,
-                    None => {
-                        more.push(order.len() as u32);
-                        order.push(c as u32);
-                        order.len() as u32 - 1
+                made_more.get(&v).and_then(|more| more.iter().copied().find(|&m| same(&data, &cur, m)))
+            };
+            let m = found.unwrap_or_else(|| {
+                let m = origins.len() as u32;
+                if first == u32::MAX {
+                    made_first[v as usize] = m;
+                } else {
+                    made_more.entry(v).or_default().push(m);
+                }
+                origins.push(base.indices[c]);
+                for ((d, v), &w) in data.iter_mut().zip(&cur).zip(&widths) {
+                    for x in &v[..w] {
+                        d.extend_from_slice(&x.to_le_bytes());
                     }
                 }
-            };
+                m
+            });
             indices.push(m);
         }
         drop((made_first, made_more, class));
         let extra = extra
             .iter()
-            .map(|s| {
-                let mut data = Vec::with_capacity(order.len() * s.width() * 4);
-                for &c in &order {
-                    for x in &s.get(c as usize)[..s.width()] {
-                        data.extend_from_slice(&x.to_le_bytes());
-                    }
-                }
-                (s.at, s.name.to_string(), Stream { format: super::accessor::Format::f32(s.ty), data, template: None })
-            })
+            .zip(data)
+            .map(|(s, data)| (s.at, s.name.to_string(), Stream { format: super::accessor::Format::f32(s.ty), data, template: None }))
             .collect();
-        let origins = order.iter().map(|&c| base.indices[c as usize]).collect();
         SplitPlan { indices, origins, leave_out: leave_out.iter().map(|s| s.to_string()).collect(), extra }
     }
 
