@@ -21,18 +21,27 @@ pub fn progress_wanted(force: bool, quiet: bool) -> bool {
     if quiet {
         return false;
     }
-    force || (std::io::stderr().is_terminal() && std::env::var_os("CI").map(|v| v.is_empty() || v == "false").unwrap_or(true))
+    force
+        || (std::io::stderr().is_terminal()
+            && std::env::var_os("CI").map(|v| v.is_empty() || v == "false").unwrap_or(true))
 }
 
 /// Runs `job` on every input, `opts.jobs` at a time; results come back in input order.
-pub fn run<T: Send>(inputs: &[PathBuf], opts: &BatchOptions, job: impl Fn(&Path) -> Result<T> + Sync) -> Result<Vec<Result<T>>> {
+pub fn run<T: Send>(
+    inputs: &[PathBuf],
+    opts: &BatchOptions,
+    job: impl Fn(&Path) -> Result<T> + Sync,
+) -> Result<Vec<Result<T>>> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
         .map_err(|e| Error::usage(format!("cannot start {} worker threads: {e}", opts.jobs)))?;
     let bar = (inputs.len() > 1 && progress_wanted(opts.force_progress, opts.quiet)).then(|| {
         let b = indicatif::ProgressBar::new(inputs.len() as u64);
-        b.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} files {elapsed} {wide_msg}").expect("valid template"));
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} files {elapsed} {wide_msg}")
+                .expect("valid template"),
+        );
         b
     });
     let results = pool.install(|| {
@@ -67,7 +76,10 @@ pub fn unique_outputs(outputs: &[PathBuf]) -> Result<()> {
     let mut seen = std::collections::HashSet::new();
     for o in outputs {
         if !seen.insert(o) {
-            return Err(Error::usage(format!("two inputs would both write {}; give them different names", o.display())));
+            return Err(Error::usage(format!(
+                "two inputs would both write {}; give them different names",
+                o.display()
+            )));
         }
     }
     Ok(())

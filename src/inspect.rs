@@ -90,7 +90,12 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
             attributes: p
                 .attributes
                 .iter()
-                .map(|(n, s)| AttrInfo { name: n.clone(), r#type: s.format.ty.clone(), component_type: s.format.component_type, normalized: s.format.normalized })
+                .map(|(n, s)| AttrInfo {
+                    name: n.clone(),
+                    r#type: s.format.ty.clone(),
+                    component_type: s.format.component_type,
+                    normalized: s.format.normalized,
+                })
                 .collect(),
             morph_targets: p.targets.len(),
             has_tangents: p.attr("TANGENT").is_some(),
@@ -102,7 +107,9 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
         .iter()
         .enumerate()
         .map(|(i, m)| {
-            let tex_image = |v: Option<&Value>| v.and_then(|t| t.get("index")).and_then(|t| t.as_u64()).and_then(|t| scene.texture_image(t as usize));
+            let tex_image = |v: Option<&Value>| {
+                v.and_then(|t| t.get("index")).and_then(|t| t.as_u64()).and_then(|t| scene.texture_image(t as usize))
+            };
             let nt = m.get("normalTexture");
             MaterialInfo {
                 index: i,
@@ -118,7 +125,13 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let images = arr("images").iter().enumerate().map(|(i, img)| image_info(&scene, i, img)).collect();
     Ok(Inspection {
         file: path.to_path_buf(),
-        format: if scene.uv_v_up { "obj" } else if std::fs::read(path).map(|b| b.starts_with(b"glTF")).unwrap_or(false) { "glb" } else { "gltf" },
+        format: if scene.uv_v_up {
+            "obj"
+        } else if std::fs::read(path).map(|b| b.starts_with(b"glTF")).unwrap_or(false) {
+            "glb"
+        } else {
+            "gltf"
+        },
         generator: scene.json.pointer("/asset/generator").and_then(|g| g.as_str()).map(String::from),
         nodes: arr("nodes").len(),
         meshes: arr("meshes").len(),
@@ -137,7 +150,17 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
         Some(_) => "file",
         None => "buffer",
     };
-    let mut info = ImageInfo { index: i, stored, bytes: 0, format: None, width: None, height: None, color: None, bits_per_channel: None, error: None };
+    let mut info = ImageInfo {
+        index: i,
+        stored,
+        bytes: 0,
+        format: None,
+        width: None,
+        height: None,
+        color: None,
+        bits_per_channel: None,
+        error: None,
+    };
     match scene.image_bytes(i) {
         Ok(bytes) => {
             info.bytes = bytes.len();
@@ -166,13 +189,29 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
 
 impl Inspection {
     pub fn text(&self) -> String {
-        let mut s = format!("{} ({}): {} nodes, {} meshes, {} animations, {} skins\n", self.file.display(), self.format, self.nodes, self.meshes, self.animations, self.skins);
+        let mut s = format!(
+            "{} ({}): {} nodes, {} meshes, {} animations, {} skins\n",
+            self.file.display(),
+            self.format,
+            self.nodes,
+            self.meshes,
+            self.animations,
+            self.skins
+        );
         if !self.extensions_used.is_empty() {
             s += &format!("  extensions: {}\n", self.extensions_used.join(", "));
         }
         for p in &self.primitives {
             let attrs: Vec<String> = p.attributes.iter().map(|a| format!("{} {}", a.name, a.r#type)).collect();
-            s += &format!("  mesh {} primitive {}: {} vertices, {} triangles, material {}\n    attributes: {}\n", p.mesh, p.primitive, p.vertices, p.triangles, p.material.map(|m| m.to_string()).unwrap_or("-".into()), attrs.join(", "));
+            s += &format!(
+                "  mesh {} primitive {}: {} vertices, {} triangles, material {}\n    attributes: {}\n",
+                p.mesh,
+                p.primitive,
+                p.vertices,
+                p.triangles,
+                p.material.map(|m| m.to_string()).unwrap_or("-".into()),
+                attrs.join(", ")
+            );
             let t = match (&p.tangents_needed_from, p.has_tangents) {
                 (Some(uv), true) => format!("present; needed (normal texture reads {uv})"),
                 (Some(uv), false) => format!("MISSING; needed (normal texture reads {uv})"),
@@ -188,7 +227,11 @@ impl Inspection {
                 parts.push(format!("base colour image {i}"));
             }
             if let Some(i) = m.normal_image {
-                parts.push(format!("normal image {i} (TEXCOORD_{}, scale {})", m.normal_tex_coord.unwrap_or(0), m.normal_scale.unwrap_or(1.0)));
+                parts.push(format!(
+                    "normal image {i} (TEXCOORD_{}, scale {})",
+                    m.normal_tex_coord.unwrap_or(0),
+                    m.normal_scale.unwrap_or(1.0)
+                ));
             }
             if let Some(h) = &m.height_map {
                 parts.push(format!("height map {}", h.display()));
@@ -197,7 +240,19 @@ impl Inspection {
         }
         for i in &self.images {
             match (&i.error, i.width) {
-                (None, Some(w)) => s += &format!("  image {}: {}x{} {} {}-bit {} ({} bytes, {})\n", i.index, w, i.height.unwrap_or(0), i.format.as_deref().unwrap_or("?"), i.bits_per_channel.unwrap_or(0), i.color.as_deref().unwrap_or(""), i.bytes, i.stored),
+                (None, Some(w)) => {
+                    s += &format!(
+                        "  image {}: {}x{} {} {}-bit {} ({} bytes, {})\n",
+                        i.index,
+                        w,
+                        i.height.unwrap_or(0),
+                        i.format.as_deref().unwrap_or("?"),
+                        i.bits_per_channel.unwrap_or(0),
+                        i.color.as_deref().unwrap_or(""),
+                        i.bytes,
+                        i.stored
+                    )
+                }
                 (Some(e), _) => s += &format!("  image {}: unreadable: {e}\n", i.index),
                 _ => s += &format!("  image {}: {} bytes\n", i.index, i.bytes),
             }

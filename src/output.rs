@@ -30,7 +30,11 @@ impl<'a> Outputs<'a> {
     }
     /// The same files, owning their bytes (for when what they borrow from goes away).
     pub fn into_owned(self) -> Outputs<'static> {
-        let files = self.files.into_iter().map(|(p, parts)| (p, parts.into_iter().map(|b| Cow::Owned(b.into_owned())).collect())).collect();
+        let files = self
+            .files
+            .into_iter()
+            .map(|(p, parts)| (p, parts.into_iter().map(|b| Cow::Owned(b.into_owned())).collect()))
+            .collect();
         Outputs { files }
     }
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
@@ -103,7 +107,8 @@ fn write_temp(path: &Path, parts: &[impl AsRef<[u8]>]) -> Result<PathBuf> {
 
 /// A Make/Ninja depfile: `target: dep dep ...`, spaces in paths escaped.
 pub fn depfile(targets: &[&Path], deps: &[PathBuf]) -> Vec<u8> {
-    let esc = |p: &Path| p.to_string_lossy().replace('\\', "/").replace(' ', "\\ ").replace('#', "\\#").replace('$', "$$");
+    let esc =
+        |p: &Path| p.to_string_lossy().replace('\\', "/").replace(' ', "\\ ").replace('#', "\\#").replace('$', "$$");
     let t: Vec<String> = targets.iter().map(|p| esc(p)).collect();
     let d: Vec<String> = deps.iter().map(|p| esc(p)).collect();
     format!("{}: {}\n", t.join(" "), d.join(" \\\n  ")).into_bytes()

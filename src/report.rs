@@ -25,6 +25,8 @@ pub fn mem_mark(stage: &str) {
         return;
     }
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    let field = |k: &str| status.lines().find(|l| l.starts_with(k)).map(|l| l[k.len()..].trim().to_string()).unwrap_or_default();
+    let field = |k: &str| {
+        status.lines().find(|l| l.starts_with(k)).map(|l| l[k.len()..].trim().to_string()).unwrap_or_default()
+    };
     eprintln!("memtrace {stage}: rss {} peak {}", field("VmRSS:"), field("VmHWM:"));
 }

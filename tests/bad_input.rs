@@ -258,7 +258,11 @@ fn obj_bump_images_are_decoded_under_limits() {
         let stem = img.trim_end_matches(".png");
         std::fs::write(d.join(format!("{stem}.mtl")), format!("newmtl m\nbump {img}\n")).unwrap();
         let obj = d.join(format!("{stem}.obj"));
-        std::fs::write(&obj, format!("mtllib {stem}.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n")).unwrap();
+        std::fs::write(
+            &obj,
+            format!("mtllib {stem}.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n"),
+        )
+        .unwrap();
         let out = d.join(format!("{stem}.gltf"));
         let t0 = std::time::Instant::now();
         let o = run(&["tangents", s(&obj), "-o", s(&out), "--all", "--json"]);
@@ -346,7 +350,8 @@ fn failures_during_the_write_leave_nothing() {
     std::fs::create_dir_all(d.join("taken.gltf")).unwrap();
     check(&d.join("taken.gltf"), "directory");
     let listing = |dir: &Path| {
-        let mut v: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        let mut v: Vec<String> =
+            std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
         v.sort();
         v
     };

@@ -21,10 +21,15 @@ fn assert_nothing_unneeded(scene: &Scene) {
         let pj = scene.prim_json(r);
         let attrs = pj["attributes"].as_object().unwrap();
         let normal_set = scene.normal_texcoord(r);
-        assert_eq!(attrs.contains_key("TANGENT"), normal_set.is_some(), "{r:?}: TANGENT exactly where a normal texture is");
+        assert_eq!(
+            attrs.contains_key("TANGENT"),
+            normal_set.is_some(),
+            "{r:?}: TANGENT exactly where a normal texture is"
+        );
         assert!(!attrs.contains_key("_BITANGENT"), "{r:?}: no bitangents unless asked");
         let mat = scene.material_of(r);
-        let sets: Vec<u64> = attrs.keys().filter_map(|k| k.strip_prefix("TEXCOORD_")).map(|k| k.parse().unwrap()).collect();
+        let sets: Vec<u64> =
+            attrs.keys().filter_map(|k| k.strip_prefix("TEXCOORD_")).map(|k| k.parse().unwrap()).collect();
         let text = mat.map(|m| m.to_string()).unwrap_or_default();
         for k in sets {
             let read = (k == 0 && text.contains("\"index\"")) || text.contains(&format!("\"texCoord\":{k}"));
@@ -91,8 +96,10 @@ fn multi_material_scene(dir: &Path) -> std::path::PathBuf {
     let tex_b = g.texture(); // same bytes as tex_a's image: deduplicated
     g.json["samplers"] = json!([{ "wrapS": 10497 }, { "wrapS": 33071 }]);
     g.json["textures"][0]["sampler"] = json!(0);
-    let stone = g.material(json!({ "name": "Stone", "pbrMetallicRoughness": { "baseColorTexture": { "index": tex_a } } }));
-    let wood = g.material(json!({ "name": "Wood", "pbrMetallicRoughness": { "baseColorTexture": { "index": tex_b } } }));
+    let stone =
+        g.material(json!({ "name": "Stone", "pbrMetallicRoughness": { "baseColorTexture": { "index": tex_a } } }));
+    let wood =
+        g.material(json!({ "name": "Wood", "pbrMetallicRoughness": { "baseColorTexture": { "index": tex_b } } }));
     let plain = g.material(json!({ "name": "Plain" }));
     let _unused = g.material(json!({ "name": "Unused" }));
     for m in [stone, wood, plain] {
@@ -114,10 +121,30 @@ fn gltf_scene_with_several_materials_one_gets_the_map() {
     let v = validated_dir("bake_multi");
     let input = multi_material_scene(&d);
     let out = v.join("multi.glb");
-    let o = run_ok(&["bake", s(&input), "--height", s(&fixture("bake/bumps.png")), "--material", "Stone", "-o", s(&out), "--json"]);
+    let o = run_ok(&[
+        "bake",
+        s(&input),
+        "--height",
+        s(&fixture("bake/bumps.png")),
+        "--material",
+        "Stone",
+        "-o",
+        s(&out),
+        "--json",
+    ]);
     let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let removed: Vec<String> = rep["removed"].as_array().unwrap().iter().map(|r| r["what"].as_str().unwrap().to_string()).collect();
-    for want in ["mesh 1 primitive 0: TANGENT", "mesh 2 primitive 0: TANGENT", "mesh 0 primitive 0: _BITANGENT", "mesh 0 primitive 0: TEXCOORD_1", "mesh 2 primitive 0: TEXCOORD_0", "material 3 'Unused'", "image 1", "sampler 1"] {
+    let removed: Vec<String> =
+        rep["removed"].as_array().unwrap().iter().map(|r| r["what"].as_str().unwrap().to_string()).collect();
+    for want in [
+        "mesh 1 primitive 0: TANGENT",
+        "mesh 2 primitive 0: TANGENT",
+        "mesh 0 primitive 0: _BITANGENT",
+        "mesh 0 primitive 0: TEXCOORD_1",
+        "mesh 2 primitive 0: TEXCOORD_0",
+        "material 3 'Unused'",
+        "image 1",
+        "sampler 1",
+    ] {
         assert!(removed.iter().any(|r| r.starts_with(want)), "{want} left out: {removed:#?}");
     }
     assert!(rep["removed_bytes"].as_u64().unwrap() > 0);
@@ -136,7 +163,17 @@ fn leaving_out_does_not_change_what_is_drawn() {
     let input = multi_material_scene(&d);
     let (all, lean) = (d.join("keep_all.glb"), v.join("lean.glb"));
     let args = |out: &Path, extra: &[&str]| {
-        let mut a = vec!["bake".to_string(), s(&input).into(), "--height".into(), s(&fixture("bake/bumps.png")).into(), "--material".into(), "Stone".into(), "-o".into(), s(out).into(), "-q".into()];
+        let mut a = vec![
+            "bake".to_string(),
+            s(&input).into(),
+            "--height".into(),
+            s(&fixture("bake/bumps.png")).into(),
+            "--material".into(),
+            "Stone".into(),
+            "-o".into(),
+            s(out).into(),
+            "-q".into(),
+        ];
         a.extend(extra.iter().map(|x| x.to_string()));
         a
     };
@@ -165,7 +202,11 @@ fn leaving_out_does_not_change_what_is_drawn() {
         let (ma, mb) = (mat(&a, r), mat(&b, r));
         assert_eq!(ma["name"], mb["name"]);
         for ptr in ["/pbrMetallicRoughness/baseColorTexture/index", "/normalTexture/index"] {
-            let img = |sc: &Scene, m: &serde_json::Value| m.pointer(ptr).and_then(|t| t.as_u64()).map(|t| sc.image_bytes(sc.texture_image(t as usize).unwrap()).unwrap());
+            let img = |sc: &Scene, m: &serde_json::Value| {
+                m.pointer(ptr)
+                    .and_then(|t| t.as_u64())
+                    .map(|t| sc.image_bytes(sc.texture_image(t as usize).unwrap()).unwrap())
+            };
             assert_eq!(img(&a, &ma), img(&b, &mb), "{r:?} {ptr}");
         }
     }
@@ -198,7 +239,18 @@ fn directx_normal_map_is_converted_and_a_wrong_declaration_refused() {
     let gl = d.join("gl.png");
     let dx = d.join("dx.png");
     run_ok(&["normalmap", s(&fixture("bake/bumps.png")), "-o", s(&gl), "--strength", "3", "--wrap", "repeat"]);
-    run_ok(&["normalmap", s(&fixture("bake/bumps.png")), "-o", s(&dx), "--strength", "3", "--wrap", "repeat", "--convention", "directx"]);
+    run_ok(&[
+        "normalmap",
+        s(&fixture("bake/bumps.png")),
+        "-o",
+        s(&dx),
+        "--strength",
+        "3",
+        "--wrap",
+        "repeat",
+        "--convention",
+        "directx",
+    ]);
     let out = v.join("dx.glb");
     let o = run_ok(&["bake", s(&fixture("bake/torus.obj")), "--normal", s(&dx), "-o", s(&out), "--json"]);
     let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -206,7 +258,8 @@ fn directx_normal_map_is_converted_and_a_wrong_declaration_refused() {
     assert_validates(&out);
     let scene = load(&out);
     let t = scene.json["materials"][0]["normalTexture"]["index"].as_u64().unwrap() as usize;
-    let embedded = image::load_from_memory(&scene.image_bytes(scene.texture_image(t).unwrap()).unwrap()).unwrap().to_rgb8();
+    let embedded =
+        image::load_from_memory(&scene.image_bytes(scene.texture_image(t).unwrap()).unwrap()).unwrap().to_rgb8();
     // Green c -> 255 - c negates the decoded n.y exactly; it differs from encoding -n.y afresh
     // only where rounding met a tie (n.y = 0 encodes to 128 both ways), by one step.
     let want = image::open(&gl).unwrap().to_rgb8();
@@ -214,7 +267,16 @@ fn directx_normal_map_is_converted_and_a_wrong_declaration_refused() {
         assert_eq!((p[0], p[2]), (q[0], q[2]), "red and blue untouched");
         assert!((p[1] as i32 - q[1] as i32).abs() <= 1, "green {} vs {}", p[1], q[1]);
     }
-    let o = run(&["bake", s(&fixture("bake/torus.obj")), "--normal", s(&dx), "--convention", "opengl", "-o", s(&d.join("no.glb"))]);
+    let o = run(&[
+        "bake",
+        s(&fixture("bake/torus.obj")),
+        "--normal",
+        s(&dx),
+        "--convention",
+        "opengl",
+        "-o",
+        s(&d.join("no.glb")),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("looks like DirectX"));
     assert!(!d.join("no.glb").exists());
@@ -225,7 +287,11 @@ fn bake_is_deterministic_across_runs_and_threads() {
     let v = validated_dir("bake_det");
     let (a, b) = (v.join("a.glb"), v.join("b.glb"));
     run_ok(&["bake", s(&fixture("bake/torus.obj")), "-o", s(&a), "-q"]);
-    let o = bin().env("RAYON_NUM_THREADS", "1").args(["bake", s(&fixture("bake/torus.obj")), "-o", s(&b), "-q"]).output().unwrap();
+    let o = bin()
+        .env("RAYON_NUM_THREADS", "1")
+        .args(["bake", s(&fixture("bake/torus.obj")), "-o", s(&b), "-q"])
+        .output()
+        .unwrap();
     assert!(o.status.success());
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
 }

@@ -10,14 +10,37 @@ fn one_corrupt_file_among_good_ones() {
     std::fs::copy(fixture("khronos/NormalTangentTest.glb"), d.join("a.glb")).unwrap();
     std::fs::write(d.join("b.glb"), b"glTF\x02\0\0\0").unwrap();
     std::fs::copy(fixture("khronos/NormalTangentMirrorTest.glb"), d.join("c.glb")).unwrap();
-    let o = run(&["tangents", s(&d.join("a.glb")), s(&d.join("b.glb")), s(&d.join("c.glb")), "--out-dir", s(&v), "-j", "2", "--json"]);
+    let o = run(&[
+        "tangents",
+        s(&d.join("a.glb")),
+        s(&d.join("b.glb")),
+        s(&d.join("c.glb")),
+        "--out-dir",
+        s(&v),
+        "-j",
+        "2",
+        "--json",
+    ]);
     assert_eq!(o.status.code(), Some(2), "a failed file makes the batch fail");
-    let lines: Vec<serde_json::Value> = String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let lines: Vec<serde_json::Value> =
+        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(lines.len(), 3, "one record per file, in input order");
     assert_eq!(lines[0]["status"], "ok");
     assert!(lines.iter().all(|l| l["schema"] == "bumpbake-tangents/1"), "every record names its schema");
     assert_eq!(lines[0]["generated"], 1);
-    for key in ["input", "output", "primitives", "kept", "skipped", "vertices_in", "vertices_out", "fallback_frames", "notes", "written", "timings_ms"] {
+    for key in [
+        "input",
+        "output",
+        "primitives",
+        "kept",
+        "skipped",
+        "vertices_in",
+        "vertices_out",
+        "fallback_frames",
+        "notes",
+        "written",
+        "timings_ms",
+    ] {
         assert!(lines[0].get(key).is_some(), "documented field {key}");
     }
     assert_eq!(lines[1]["exit_code"], 2);
@@ -63,9 +86,20 @@ fn normalmap_batch_writes_the_good_maps_and_names_the_bad_one() {
     std::fs::copy(fixture("bake/bumps.png"), d.join("a.png")).unwrap();
     std::fs::write(d.join("b.png"), b"\x89PNG\r\n\x1a\nbroken").unwrap();
     image::GrayImage::from_pixel(3, 3, image::Luma([7])).save(d.join("c.png")).unwrap();
-    let o = run(&["normalmap", s(&d.join("a.png")), s(&d.join("b.png")), s(&d.join("c.png")), "--out-dir", s(&out), "--json", "-j", "2"]);
+    let o = run(&[
+        "normalmap",
+        s(&d.join("a.png")),
+        s(&d.join("b.png")),
+        s(&d.join("c.png")),
+        "--out-dir",
+        s(&out),
+        "--json",
+        "-j",
+        "2",
+    ]);
     assert_eq!(o.status.code(), Some(2));
-    let recs: Vec<serde_json::Value> = String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let recs: Vec<serde_json::Value> =
+        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(recs.iter().map(|r| r["status"].as_str().unwrap()).collect::<Vec<_>>(), ["ok", "error", "ok"]);
     assert!(recs[0]["timings_ms"]["stages"].as_array().unwrap().len() >= 2);
     assert!(recs[1]["error"].as_str().unwrap().contains("b.png"));
@@ -116,6 +150,7 @@ fn bench_command_reports_the_whole_commands_time_and_peak_memory() {
     assert!((ratio - peak as f64 * 1024.0 / r["input_bytes"].as_f64().unwrap()).abs() < 1e-9);
     assert!(r["min_s"].as_f64().unwrap() <= r["median_s"].as_f64().unwrap());
     // A file that is not a mesh is the command's error, reported as one line.
-    let bad = run(&["bench", "command", s(&fixture("khronos/NormalTangentTest.mesh0.prim0.tangents.txt")), "--runs", "1"]);
+    let bad =
+        run(&["bench", "command", s(&fixture("khronos/NormalTangentTest.mesh0.prim0.tangents.txt")), "--runs", "1"]);
     assert_eq!(bad.status.code(), Some(2));
 }

@@ -68,6 +68,13 @@ fn man_page_is_roff_with_every_subcommand() {
     // Every roff request line is a known macro.
     for l in text.lines().filter(|l| l.starts_with('.')) {
         let m = l.split_whitespace().next().unwrap();
-        assert!([".TH", ".SH", ".TP", ".PP", ".ie", ".el", ".RS", ".RE", ".br", ".IP", ".B", ".I", ".sp", ".nf", ".fi", ".SS"].contains(&m), "unknown macro {m}");
+        assert!(
+            [
+                ".TH", ".SH", ".TP", ".PP", ".ie", ".el", ".RS", ".RE", ".br", ".IP", ".B", ".I", ".sp", ".nf", ".fi",
+                ".SS"
+            ]
+            .contains(&m),
+            "unknown macro {m}"
+        );
     }
 }

@@ -18,7 +18,8 @@ fn exercise(path: &str, data: &[u8]) {
         let _ = scene.primitive(r);
     }
     if apply(&mut scene, &ApplyOptions { all: true, ..Default::default() }).is_ok() {
-        let _ = bumpbake::scene::write(&scene, Path::new("/nonexistent-bumpbake-fuzz/out.glb"), &WriteOptions::default());
+        let _ =
+            bumpbake::scene::write(&scene, Path::new("/nonexistent-bumpbake-fuzz/out.glb"), &WriteOptions::default());
     }
 }
 

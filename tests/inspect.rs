@@ -5,8 +5,14 @@ use common::*;
 
 #[test]
 fn inspect_json_names_attributes_tangent_need_and_images() {
-    let o = run_ok(&["inspect", s(&fixture("khronos/NormalTangentTest.glb")), s(&fixture("khronos/NormalTangentMirrorTest.glb")), "--json"]);
-    let recs: Vec<serde_json::Value> = String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let o = run_ok(&[
+        "inspect",
+        s(&fixture("khronos/NormalTangentTest.glb")),
+        s(&fixture("khronos/NormalTangentMirrorTest.glb")),
+        "--json",
+    ]);
+    let recs: Vec<serde_json::Value> =
+        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(recs.len(), 2);
     let a = &recs[0];
     assert_eq!(a["format"], "glb");
@@ -29,7 +35,11 @@ fn inspect_sees_a_16_bit_image_and_an_obj_height_map() {
     let h = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(3, 2, |x, _| image::Luma([x as u16 * 1000]));
     h.save(d.join("h.png")).unwrap();
     std::fs::write(d.join("m.mtl"), "newmtl m\nbump h.png\nmap_Kd h.png\n").unwrap();
-    std::fs::write(d.join("t.obj"), "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n").unwrap();
+    std::fs::write(
+        d.join("t.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
     let o = run_ok(&["inspect", s(&d.join("t.obj")), "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["images"][0]["bits_per_channel"], 16);

@@ -56,17 +56,8 @@ impl Mesh {
 
 const COORDS: [f32; 10] = [0.0, -0.0, 1.0, -1.0, 0.5, 2.0, 0.25, 3.0, -2.5, 1.5];
 const UVS: [f32; 8] = [0.0, -0.0, 1.0, 0.5, -1.0, 2.0, 0.25, 0.75];
-const WILD: [f32; 9] = [
-    f32::NAN,
-    f32::INFINITY,
-    f32::NEG_INFINITY,
-    3.0e38,
-    -3.0e38,
-    1.0e-40,
-    -1.0e-42,
-    1.0e-20,
-    f32::MIN_POSITIVE,
-];
+const WILD: [f32; 9] =
+    [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 3.0e38, -3.0e38, 1.0e-40, -1.0e-42, 1.0e-20, f32::MIN_POSITIVE];
 
 fn coord(r: &mut Words, wild: bool) -> f32 {
     let x = r.next();
@@ -343,9 +334,7 @@ fn build(kind: u8, words: &[u32]) -> Mesh {
 fn same(a: Option<[f32; 4]>, b: Option<[f32; 4]>) -> bool {
     match (a, b) {
         (None, None) => true,
-        (Some(a), Some(b)) => {
-            a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()))
-        }
+        (Some(a), Some(b)) => a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan())),
         _ => false,
     }
 }

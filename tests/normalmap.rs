@@ -166,7 +166,20 @@ fn spectral_matches_a_sine_within_the_output_quantisation() {
     let input = d.path("sine.exr");
     img.save(&input).unwrap();
     let out = d.path("n16.png");
-    ok(&["normalmap", p(&input), "-o", p(&out), "--filter", "spectral", "--wrap", "repeat", "--strength", "4", "--bits", "16"]);
+    ok(&[
+        "normalmap",
+        p(&input),
+        "-o",
+        p(&out),
+        "--filter",
+        "spectral",
+        "--wrap",
+        "repeat",
+        "--strength",
+        "4",
+        "--bits",
+        "16",
+    ]);
     let got = read_rgb16(&out);
     for y in 0..h {
         for x in 0..w {
@@ -322,7 +335,16 @@ fn output_is_the_same_whatever_the_thread_count() {
     for f in ["sobel", "central4", "spectral"] {
         let (a, b) = (d.path("a.png"), d.path("b.png"));
         let args = |o: &Path| {
-            vec!["normalmap".to_string(), p(&input).into(), "-o".into(), p(o).into(), "--filter".into(), f.into(), "--alpha".into(), "height".into()]
+            vec![
+                "normalmap".to_string(),
+                p(&input).into(),
+                "-o".into(),
+                p(o).into(),
+                "--filter".into(),
+                f.into(),
+                "--alpha".into(),
+                "height".into(),
+            ]
         };
         let st = bin().args(args(&a)).env("RAYON_NUM_THREADS", "1").status().unwrap();
         assert!(st.success());
@@ -481,7 +503,20 @@ fn streamed_png_matches_the_in_memory_encoder_across_strips() {
     for (bits, depth) in [("8", nm::Depth::Bits8), ("16", nm::Depth::Bits16)] {
         for f in ["sobel", "spectral"] {
             let out = d.path("n.png");
-            ok(&["normalmap", p(&input), "-o", p(&out), "--bits", bits, "--filter", f, "--alpha", "height", "--strength", "3"]);
+            ok(&[
+                "normalmap",
+                p(&input),
+                "-o",
+                p(&out),
+                "--bits",
+                bits,
+                "--filter",
+                f,
+                "--alpha",
+                "height",
+                "--strength",
+                "3",
+            ]);
             let filter = if f == "sobel" { nm::Filter::Sobel } else { nm::Filter::Spectral };
             let opts = nm::Options { strength: 3.0, filter, ..Default::default() };
             let enc = nm::EncodeOptions { depth, alpha_height: true, ..Default::default() };

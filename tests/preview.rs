@@ -54,7 +54,11 @@ fn normal_map(r: u32, s: f64, grad: impl Fn(f64, f64) -> (f64, f64), flip_green:
 
 /// A grid of `n x n` quads over the unit square at height `z(x, y)` with normals `normal(x, y)`,
 /// UVs (x, 1 - y) in glTF's v-down convention.
-fn surface(n: usize, z: impl Fn(f64, f64) -> f64, normal: impl Fn(f64, f64) -> [f64; 3]) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u16>) {
+fn surface(
+    n: usize,
+    z: impl Fn(f64, f64) -> f64,
+    normal: impl Fn(f64, f64) -> [f64; 3],
+) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u16>) {
     let (p, _, uv, idx) = grid(n);
     let pos = p.iter().map(|q| [q[0], q[1], z(q[0] as f64, q[1] as f64) as f32]).collect();
     let nrm = p.iter().map(|q| normal(q[0] as f64, q[1] as f64).map(|c| c as f32)).collect();
@@ -62,7 +66,12 @@ fn surface(n: usize, z: impl Fn(f64, f64) -> f64, normal: impl Fn(f64, f64) -> [
 }
 
 /// Writes a one-primitive GLB; `normal_png` makes a material with that normal texture.
-fn write_mesh(path: &Path, mesh: (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u16>), tangents: Option<Vec<[f32; 4]>>, normal_png: Option<&[u8]>) {
+fn write_mesh(
+    path: &Path,
+    mesh: (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u16>),
+    tangents: Option<Vec<[f32; 4]>>,
+    normal_png: Option<&[u8]>,
+) {
     let (p, n, uv, idx) = mesh;
     let mut g = Gltf::new();
     let a_p = g.floats(&p, Some(34962));
@@ -217,7 +226,8 @@ fn mirrored_halves_of_the_khronos_model_render_alike() {
     // side depends on how each tile's UVs are mirrored and rotated): the same measure tells.
     let mut scene = load(&model);
     let mut p = scene.primitive(P0).unwrap();
-    let t: Vec<[f32; 4]> = p.attr("TANGENT").unwrap().to_f32::<4>().into_iter().map(|t| [t[0], t[1], t[2], 1.0]).collect();
+    let t: Vec<[f32; 4]> =
+        p.attr("TANGENT").unwrap().to_f32::<4>().into_iter().map(|t| [t[0], t[1], t[2], 1.0]).collect();
     p.set_attr("TANGENT", bumpbake::scene::Stream::from_f32("VEC4", &t));
     scene.set_primitive(P0, &p);
     let broken = dir.join("no_w.glb");
@@ -244,14 +254,32 @@ fn mirrored_halves_of_the_khronos_model_render_alike() {
 fn handedness_view_shows_both_colours_on_a_mirrored_mesh() {
     let dir = scratch_dir("preview_handedness");
     let img = dir.join("hand.png");
-    preview(&[s(&fixture("khronos/NormalTangentMirrorTest.glb")), "-o", s(&img), "--view", "handedness", "--size", "128x128", "-q"]);
+    preview(&[
+        s(&fixture("khronos/NormalTangentMirrorTest.glb")),
+        "-o",
+        s(&img),
+        "--view",
+        "handedness",
+        "--size",
+        "128x128",
+        "-q",
+    ]);
     let (right, left) = handedness_masks(&img);
     let (r, l) = (right.iter().filter(|&&b| b).count(), left.iter().filter(|&&b| b).count());
     assert!(r > 500 && l > 500, "right-handed {r}, left-handed {l} pixels");
 
     // A mesh without mirrored UVs is one colour.
     let plain = dir.join("plain.png");
-    preview(&[s(&fixture("khronos/NormalTangentTest.glb")), "-o", s(&plain), "--view", "handedness", "--size", "128x128", "-q"]);
+    preview(&[
+        s(&fixture("khronos/NormalTangentTest.glb")),
+        "-o",
+        s(&plain),
+        "--view",
+        "handedness",
+        "--size",
+        "128x128",
+        "-q",
+    ]);
     let (right, left) = handedness_masks(&plain);
     let (r, l) = (right.iter().filter(|&&b| b).count(), left.iter().filter(|&&b| b).count());
     assert!(r.min(l) == 0 && r.max(l) > 1000, "right-handed {r}, left-handed {l} pixels");
@@ -301,7 +329,8 @@ fn coarse_asset(scratch: &Path, dir: &Path, name: &str, flip_green: bool) -> Pat
 }
 
 fn pipeline_error(reference: &Path, candidate: &Path, out: &Path) -> Value {
-    let o = preview(&["--reference", s(reference), "--compare", s(candidate), "-o", s(out), "--size", "160x160", "--json"]);
+    let o =
+        preview(&["--reference", s(reference), "--compare", s(candidate), "-o", s(out), "--size", "160x160", "--json"]);
     let j: Value = serde_json::from_slice(&o.stdout).expect("JSON report");
     assert!(out.exists());
     j["comparison"].clone()
@@ -329,7 +358,8 @@ fn pipeline_error_is_small_and_catches_flipped_green_and_w() {
     // Flipped w: the same asset with every handedness negated.
     let mut scene = load(&lo);
     let mut p = scene.primitive(P0).unwrap();
-    let t: Vec<[f32; 4]> = p.attr("TANGENT").unwrap().to_f32::<4>().into_iter().map(|t| [t[0], t[1], t[2], -t[3]]).collect();
+    let t: Vec<[f32; 4]> =
+        p.attr("TANGENT").unwrap().to_f32::<4>().into_iter().map(|t| [t[0], t[1], t[2], -t[3]]).collect();
     p.set_attr("TANGENT", bumpbake::scene::Stream::from_f32("VEC4", &t));
     scene.set_primitive(P0, &p);
     let flipped = scratch.join("w.glb");
@@ -347,7 +377,11 @@ fn renders_obj_and_is_deterministic() {
     let (a, b) = (dir.join("a.png"), dir.join("b.png"));
     let obj = fixture("spot/spot.obj");
     preview(&[s(&obj), "-o", s(&a), "--size", "96x96", "--ssaa", "2", "--yaw", "150", "-q"]);
-    let out = bin().args(["preview", s(&obj), "-o", s(&b), "--size", "96x96", "--ssaa", "2", "--yaw", "150", "-q"]).env("RAYON_NUM_THREADS", "1").output().unwrap();
+    let out = bin()
+        .args(["preview", s(&obj), "-o", s(&b), "--size", "96x96", "--ssaa", "2", "--yaw", "150", "-q"])
+        .env("RAYON_NUM_THREADS", "1")
+        .output()
+        .unwrap();
     assert!(out.status.success());
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "output depends on threads");
     let (_, _, l) = luma(&a);
@@ -366,7 +400,22 @@ fn every_view_and_light_kind_renders() {
         assert_eq!((img.width(), img.height()), (48, 32));
     }
     let p = dir.join("lights.png");
-    preview(&[s(&m), "-o", s(&p), "--size", "48x48", "--light", "point:0,0,3@0.5", "--light", "spot:0,0,3:0,0,-1:20", "--yaw", "-30", "--pitch", "-10", "-q"]);
+    preview(&[
+        s(&m),
+        "-o",
+        s(&p),
+        "--size",
+        "48x48",
+        "--light",
+        "point:0,0,3@0.5",
+        "--light",
+        "spot:0,0,3:0,0,-1:20",
+        "--yaw",
+        "-30",
+        "--pitch",
+        "-10",
+        "-q",
+    ]);
     // A camera inside the bounds exercises near-plane clipping.
     preview(&[s(&m), "-o", s(&p), "--size", "48x48", "--distance", "0.05", "-q"]);
 }
@@ -394,10 +443,13 @@ fn bad_input_exits_2_with_one_line_naming_the_file() {
     // A texture that is not an image.
     let mut g = Gltf::new();
     let (p, n, uv, idx) = grid(1);
-    let (a_p, a_n, a_uv, a_i) = (g.floats(&p, Some(34962)), g.floats(&n, Some(34962)), g.floats(&uv, Some(34962)), g.indices(&idx));
+    let (a_p, a_n, a_uv, a_i) =
+        (g.floats(&p, Some(34962)), g.floats(&n, Some(34962)), g.floats(&uv, Some(34962)), g.indices(&idx));
     let t = add_texture(&mut g, b"not a png");
     let m = g.material(json!({ "normalTexture": { "index": t } }));
-    g.mesh(json!({ "attributes": { "POSITION": a_p, "NORMAL": a_n, "TEXCOORD_0": a_uv }, "indices": a_i, "material": m }));
+    g.mesh(
+        json!({ "attributes": { "POSITION": a_p, "NORMAL": a_n, "TEXCOORD_0": a_uv }, "indices": a_i, "material": m }),
+    );
     let bad_tex = dir.join("badtex.glb");
     g.write_glb(&bad_tex);
     let o = run(&["preview", s(&bad_tex), "-o", s(&out_png)]);

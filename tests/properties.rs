@@ -37,7 +37,11 @@ fn unit_normals(ns: &[[f32; 3]]) -> Vec<[f32; 3]> {
         .map(|n| {
             let v = Vec3::from(*n);
             let m = v.abs().max_element();
-            if m == 0.0 { [0.0, 0.0, 1.0] } else { (v / m).normalize().to_array() }
+            if m == 0.0 {
+                [0.0, 0.0, 1.0]
+            } else {
+                (v / m).normalize().to_array()
+            }
         })
         .collect()
 }

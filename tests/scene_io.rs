@@ -73,8 +73,10 @@ fn untouched_parts_of_a_gltf_survive_unchanged() {
     g.json["cameras"] = json!([{ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.1 } }]);
     g.json["samplers"] = json!([{ "magFilter": 9729, "wrapS": 33648 }]);
     g.json["textures"][0]["sampler"] = json!(0);
-    g.json["extensionsUsed"] = json!(["KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_lights_punctual"]);
-    g.json["extensions"] = json!({ "KHR_lights_punctual": { "lights": [{ "type": "directional", "intensity": 3.0 }] } });
+    g.json["extensionsUsed"] =
+        json!(["KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_lights_punctual"]);
+    g.json["extensions"] =
+        json!({ "KHR_lights_punctual": { "lights": [{ "type": "directional", "intensity": 3.0 }] } });
     g.json["extras"] = json!({ "pipeline": "bumpbake test" });
     g.json["asset"]["copyright"] = json!("test");
     let input = g.write_gltf(&d, "rig");
@@ -99,7 +101,9 @@ fn untouched_parts_of_a_gltf_survive_unchanged() {
         }
     }
     // Animation and skin data are the same accessors' contents.
-    let acc = |sc: &bumpbake::scene::Scene, ptr: &str| sc.accessor(sc.json.pointer(ptr).unwrap().as_u64().unwrap() as usize).unwrap().data;
+    let acc = |sc: &bumpbake::scene::Scene, ptr: &str| {
+        sc.accessor(sc.json.pointer(ptr).unwrap().as_u64().unwrap() as usize).unwrap().data
+    };
     for ptr in ["/animations/0/samplers/0/input", "/animations/0/samplers/0/output", "/skins/0/inverseBindMatrices"] {
         assert_eq!(acc(&after, ptr), acc(&before, ptr), "{ptr}");
     }
@@ -151,7 +155,11 @@ fn obj_height_bump_is_reported_for_bake() {
     let grey = image::GrayImage::from_fn(4, 4, |x, _| image::Luma([(x * 60) as u8]));
     grey.save(d.join("h.png")).unwrap();
     std::fs::write(d.join("m.mtl"), "newmtl m\nmap_Bump -bm 0.3 h.png\n").unwrap();
-    std::fs::write(d.join("t.obj"), "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nusemtl m\nf 1/1/1 2/2/1 3/3/1\n").unwrap();
+    std::fs::write(
+        d.join("t.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nusemtl m\nf 1/1/1 2/2/1 3/3/1\n",
+    )
+    .unwrap();
     let out = v.join("t.glb");
     let o = run_ok(&["tangents", s(&d.join("t.obj")), "-o", s(&out)]);
     let err = String::from_utf8_lossy(&o.stderr);

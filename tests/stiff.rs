@@ -330,4 +330,3 @@ fn multi_primitive_scene_is_deterministic_across_thread_counts() {
     assert_eq!(outputs[0], outputs[2], "1 thread vs 3");
     assert_eq!(load(&a).primitives().len(), 8);
 }
-

@@ -134,14 +134,16 @@ fn tangents_only_where_a_normal_texture_reads_them_from_its_uv_set() {
     let uv1: Vec<[f32; 2]> = pos.iter().map(|p| [p[1], p[0]]).collect();
     let tex = g.texture();
     let with_map = g.material(json!({ "name": "bumpy", "normalTexture": { "index": tex, "texCoord": 1 } }));
-    let plain = g.material(json!({ "name": "plain", "pbrMetallicRoughness": { "baseColorTexture": { "index": tex } } }));
+    let plain =
+        g.material(json!({ "name": "plain", "pbrMetallicRoughness": { "baseColorTexture": { "index": tex } } }));
     for mat in [Some(with_map), Some(plain), None] {
         let p = g.floats(&pos, Some(34962));
         let n = g.floats(&nrm, Some(34962));
         let t0 = g.floats(&uv0, Some(34962));
         let t1 = g.floats(&uv1, Some(34962));
         let i = g.indices(&idx);
-        let mut prim = json!({ "attributes": { "POSITION": p, "NORMAL": n, "TEXCOORD_0": t0, "TEXCOORD_1": t1 }, "indices": i });
+        let mut prim =
+            json!({ "attributes": { "POSITION": p, "NORMAL": n, "TEXCOORD_0": t0, "TEXCOORD_1": t1 }, "indices": i });
         if let Some(m) = mat {
             prim["material"] = json!(m);
         }
@@ -172,19 +174,39 @@ fn degenerate_triangles_get_valid_fallback_frames() {
     let v = validated_dir("degen");
     let mut g = Gltf::new();
     let pos = [
-        [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], // good
-        [2.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 0.0, 0.0], // zero area
-        [3.0, 0.0, 0.0], [4.0, 0.0, 0.0], [3.0, 1.0, 0.0], // zero UV area
-        [5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 0.0], // collinear UVs
-        [7.0, 0.0, 0.0], [8.0, 0.0, 0.0], [7.0, 1.0, 0.0], // repeated index
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0], // good
+        [2.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0], // zero area
+        [3.0, 0.0, 0.0],
+        [4.0, 0.0, 0.0],
+        [3.0, 1.0, 0.0], // zero UV area
+        [5.0, 0.0, 0.0],
+        [6.0, 0.0, 0.0],
+        [5.0, 1.0, 0.0], // collinear UVs
+        [7.0, 0.0, 0.0],
+        [8.0, 0.0, 0.0],
+        [7.0, 1.0, 0.0], // repeated index
         [1.0, 1.0, 0.0], // shares an edge with the good triangle, zero UV area there
     ];
     let uv = [
-        [0.0, 1.0], [1.0, 1.0], [0.0, 0.0],
-        [0.0, 0.0], [1.0, 0.0], [0.0, 1.0],
-        [0.5, 0.5], [0.5, 0.5], [0.5, 0.5],
-        [0.0, 0.0], [0.5, 0.5], [1.0, 1.0],
-        [0.0, 1.0], [1.0, 1.0], [0.0, 0.0],
+        [0.0, 1.0],
+        [1.0, 1.0],
+        [0.0, 0.0],
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [0.0, 1.0],
+        [0.5, 0.5],
+        [0.5, 0.5],
+        [0.5, 0.5],
+        [0.0, 0.0],
+        [0.5, 0.5],
+        [1.0, 1.0],
+        [0.0, 1.0],
+        [1.0, 1.0],
+        [0.0, 0.0],
         [1.0, 1.0],
     ];
     let nrm: Vec<[f32; 3]> = vec![[0.0, 0.0, 1.0]; pos.len()];

@@ -118,7 +118,11 @@ fn w_differs_between_corners_of_a_triangle() {
     assert_only(&r, "TANGENT_W_MIXED", "error");
     assert_eq!(code, 1);
     let f = finding(&r, "TANGENT_W_MIXED");
-    assert_eq!((f["count"].as_u64(), f["total"].as_u64()), (Some(6), Some(8)), "the centre vertex touches six triangles");
+    assert_eq!(
+        (f["count"].as_u64(), f["total"].as_u64()),
+        (Some(6), Some(8)),
+        "the centre vertex touches six triangles"
+    );
 }
 
 #[test]
@@ -155,7 +159,8 @@ fn flipped_w_disagrees_with_uv_orientation() {
 /// Two quads sharing the edge x = 1, the right one with mirrored UVs. `seam_w` gives the two
 /// shared vertices one tangent (`None`: no tangents at all).
 fn mirror_prim(seam_w: Option<f32>) -> Prim {
-    let pos = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]];
+    let pos =
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]];
     let uv = vec![[0.0, 1.0], [1.0, 1.0], [0.0, 1.0], [0.0, 0.0], [1.0, 0.0], [0.0, 0.0]];
     let left = [1.0, 0.0, 0.0, 1.0];
     let right = [-1.0, 0.0, 0.0, -1.0];
@@ -255,7 +260,10 @@ fn zero_uv_area_triangle_is_info() {
 
 #[test]
 fn sliver_triangle_is_info() {
-    let p = with_extra_triangle([[2.0, 0.0, 0.0], [3.0, 0.0, 0.0], [2.5, 1e-4, 0.0]], [[0.0, 1.0], [1.0, 1.0], [0.5, 1.0 - 1e-4]]);
+    let p = with_extra_triangle(
+        [[2.0, 0.0, 0.0], [3.0, 0.0, 0.0], [2.5, 1e-4, 0.0]],
+        [[0.0, 1.0], [1.0, 1.0], [0.5, 1.0 - 1e-4]],
+    );
     let (code, r) = broken("sliver", &p, true, &["--strict"]);
     assert_only(&r, "TRIANGLE_SLIVER", "info");
     assert_eq!(code, 0);
@@ -272,7 +280,10 @@ fn mirrored_instance_is_info() {
     let tex = texture_of(&mut g, &bumpy(false));
     let m = g.material(json!({ "normalTexture": { "index": tex } }));
     g.mesh(json!({ "attributes": attrs, "indices": i, "material": m }));
-    g.json["nodes"].as_array_mut().unwrap().push(json!({ "name": "mirror", "scale": [-1.0, 1.0, 1.0], "children": [0] }));
+    g.json["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "name": "mirror", "scale": [-1.0, 1.0, 1.0], "children": [0] }));
     g.json["scenes"][0]["nodes"] = json!([1]);
     let path = d.join("mirrored.glb");
     g.write_glb(&path);
@@ -402,10 +413,13 @@ fn green_channel_convention_on_height_fields() {
         ("ripple", Box::new(|x, y| 3.0 * (((x - 32.0).powi(2) + (y - 32.0).powi(2)).sqrt() / 3.0).sin())),
         ("saddle", Box::new(|x, y| (x - 32.0) * (y - 32.0) / 40.0)),
         ("egg crate with slope", Box::new(|x, y| 2.0 * (x / 3.0).sin() * (y / 4.0).sin() + 0.3 * x + 0.1 * y)),
-        ("two bumps and a dent", Box::new(|x, y| {
-            let g = |cx: f64, cy: f64, r: f64| (-((x - cx).powi(2) + (y - cy).powi(2)) / (r * r)).exp();
-            10.0 * g(20.0, 20.0, 8.0) + 6.0 * g(45.0, 40.0, 5.0) - 8.0 * g(30.0, 50.0, 10.0)
-        })),
+        (
+            "two bumps and a dent",
+            Box::new(|x, y| {
+                let g = |cx: f64, cy: f64, r: f64| (-((x - cx).powi(2) + (y - cy).powi(2)) / (r * r)).exp();
+                10.0 * g(20.0, 20.0, 8.0) + 6.0 * g(45.0, 40.0, 5.0) - 8.0 * g(30.0, 50.0, 10.0)
+            }),
+        ),
     ];
     for (name, h) in &fields {
         for strength in [0.5, 2.0] {
@@ -418,7 +432,8 @@ fn green_channel_convention_on_height_fields() {
         }
     }
     // A map that cannot tell (relief that is a sum f(x) + g(y) has no twist) is not accused.
-    let (_, conf) = detect_convention(&normal_map(64, 64, 1.0, true, |x, y| 3.0 * (x / 5.0).sin() + 2.0 * (y / 4.0).cos()));
+    let (_, conf) =
+        detect_convention(&normal_map(64, 64, 1.0, true, |x, y| 3.0 * (x / 5.0).sin() + 2.0 * (y / 4.0).cos()));
     assert!(conf < 0.5, "separable relief gives no evidence: {conf}");
 }
 
@@ -432,15 +447,23 @@ fn normalmap_output_is_recognised_in_both_conventions() {
         ("gaussian bump", Box::new(|x, y| 0.1 + 0.8 * (-((x - 40.0).powi(2) + (y - 25.0).powi(2)) / 200.0).exp())),
         ("ripple", Box::new(|x, y| 0.5 + 0.3 * (((x - 32.0).powi(2) + (y - 32.0).powi(2)).sqrt() / 3.0).sin())),
         ("saddle", Box::new(|x, y| 0.5 + (x - 32.0) * (y - 32.0) / 2500.0)),
-        ("egg crate with slope", Box::new(|x, y| 0.3 + 0.1 * (x / 3.0).sin() * (y / 4.0).sin() + 0.004 * x + 0.002 * y)),
-        ("two bumps and a dent", Box::new(|x, y| {
-            let g = |cx: f64, cy: f64, r: f64| (-((x - cx).powi(2) + (y - cy).powi(2)) / (r * r)).exp();
-            0.4 + 0.4 * g(20.0, 20.0, 8.0) + 0.2 * g(45.0, 40.0, 5.0) - 0.3 * g(30.0, 50.0, 10.0)
-        })),
+        (
+            "egg crate with slope",
+            Box::new(|x, y| 0.3 + 0.1 * (x / 3.0).sin() * (y / 4.0).sin() + 0.004 * x + 0.002 * y),
+        ),
+        (
+            "two bumps and a dent",
+            Box::new(|x, y| {
+                let g = |cx: f64, cy: f64, r: f64| (-((x - cx).powi(2) + (y - cy).powi(2)) / (r * r)).exp();
+                0.4 + 0.4 * g(20.0, 20.0, 8.0) + 0.2 * g(45.0, 40.0, 5.0) - 0.3 * g(30.0, 50.0, 10.0)
+            }),
+        ),
     ];
     let d = scratch_dir("validate_nm_conventions");
     for (k, (name, h)) in fields.iter().enumerate() {
-        let height = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(64, 64, |x, y| image::Luma([(h(x as f64, y as f64).clamp(0.0, 1.0) * 65535.0).round() as u16]));
+        let height = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(64, 64, |x, y| {
+            image::Luma([(h(x as f64, y as f64).clamp(0.0, 1.0) * 65535.0).round() as u16])
+        });
         let hp = d.join(format!("h{k}.png"));
         height.save(&hp).unwrap();
         for (conv, want) in [("opengl", "opengl"), ("directx", "directx")] {
@@ -534,7 +557,10 @@ fn json_schema_is_stable() {
     let file = &r["files"][0];
     assert_eq!(file["kind"], "mesh");
     let sub = &file["subjects"][0];
-    assert_eq!((sub["kind"].as_str(), sub["mesh"].as_u64(), sub["primitive"].as_u64()), (Some("primitive"), Some(0), Some(0)));
+    assert_eq!(
+        (sub["kind"].as_str(), sub["mesh"].as_u64(), sub["primitive"].as_u64()),
+        (Some("primitive"), Some(0), Some(0))
+    );
     assert!(sub["checks"].as_array().unwrap().iter().any(|c| c == "TANGENT_MIKK_ANGLE"));
     let f = finding(&r, "TANGENT_W_MISMATCH_UV");
     for key in ["code", "severity", "count", "total", "unit", "message", "hint", "examples", "metrics"] {
@@ -556,7 +582,8 @@ fn junit_has_a_testcase_per_primitive_and_check() {
     assert!(x.starts_with("<?xml"), "{x}");
     let cases = x.matches("<testcase ").count();
     let (_, r) = validate(&[s(&path)]);
-    let expected: usize = r["files"][0]["subjects"].as_array().unwrap().iter().map(|s| s["checks"].as_array().unwrap().len()).sum();
+    let expected: usize =
+        r["files"][0]["subjects"].as_array().unwrap().iter().map(|s| s["checks"].as_array().unwrap().len()).sum();
     assert_eq!(cases, expected);
     assert_eq!(x.matches("<failure ").count(), 1);
     assert!(x.contains("type=\"TANGENT_W_MISMATCH_UV\""));

@@ -26,7 +26,10 @@ pub fn exercise(path: &str, data: &[u8]) {
         for (k, (t, n)) in t.to_f32::<4>().iter().zip(n.to_f32::<3>()).enumerate() {
             let v = glam::Vec3::new(t[0], t[1], t[2]);
             let n = glam::Vec3::from(n).normalize_or_zero();
-            assert!(v.is_finite() && (v.length() - 1.0).abs() < 1e-4 && (t[3] == 1.0 || t[3] == -1.0), "vertex {k}: bad tangent {t:?}");
+            assert!(
+                v.is_finite() && (v.length() - 1.0).abs() < 1e-4 && (t[3] == 1.0 || t[3] == -1.0),
+                "vertex {k}: bad tangent {t:?}"
+            );
             if n != glam::Vec3::ZERO {
                 assert!(v.dot(n).abs() < 1e-3, "vertex {k}: tangent {t:?} not orthogonal to {n:?}");
             }

@@ -44,7 +44,11 @@ fuzz_target!(|m: Mesh| {
                 // few bits left, and a "normalised" vector 2% too long (this harness's first crash).
                 let v = glam::Vec3::from(ns.get(i).copied().map(finite).unwrap_or([0.0, 0.0, 1.0]));
                 let m = v.abs().max_element();
-                if m == 0.0 { [0.0, 0.0, 1.0] } else { (v / m).normalize().to_array() }
+                if m == 0.0 {
+                    [0.0, 0.0, 1.0]
+                } else {
+                    (v / m).normalize().to_array()
+                }
             })
             .collect();
         attributes.push(("NORMAL".to_string(), Stream::from_f32("VEC3", &nv)));

@@ -18,16 +18,34 @@ pub struct Removal {
 
 /// Extensions whose texture and image references [`texture_refs`] and [`image_refs`] follow.
 const KNOWN: &[&str] = &[
-    "KHR_texture_transform", "KHR_lights_punctual", "KHR_materials_clearcoat", "KHR_materials_emissive_strength",
-    "KHR_materials_ior", "KHR_materials_iridescence", "KHR_materials_sheen", "KHR_materials_specular",
-    "KHR_materials_transmission", "KHR_materials_unlit", "KHR_materials_variants", "KHR_materials_volume",
-    "KHR_materials_anisotropy", "KHR_materials_dispersion", "KHR_mesh_quantization", "KHR_texture_basisu",
-    "EXT_texture_webp", "EXT_mesh_gpu_instancing",
+    "KHR_texture_transform",
+    "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_iridescence",
+    "KHR_materials_sheen",
+    "KHR_materials_specular",
+    "KHR_materials_transmission",
+    "KHR_materials_unlit",
+    "KHR_materials_variants",
+    "KHR_materials_volume",
+    "KHR_materials_anisotropy",
+    "KHR_materials_dispersion",
+    "KHR_mesh_quantization",
+    "KHR_texture_basisu",
+    "EXT_texture_webp",
+    "EXT_mesh_gpu_instancing",
 ];
 
 pub fn leave_out(scene: &mut Scene, keep_bitangents: bool) -> Result<Vec<Removal>> {
     let mut removed = attributes(scene, keep_bitangents)?;
-    let unknown = scene.json.get("extensionsUsed").and_then(|e| e.as_array()).map(|l| l.iter().any(|e| !KNOWN.contains(&e.as_str().unwrap_or("")))).unwrap_or(false);
+    let unknown = scene
+        .json
+        .get("extensionsUsed")
+        .and_then(|e| e.as_array())
+        .map(|l| l.iter().any(|e| !KNOWN.contains(&e.as_str().unwrap_or(""))))
+        .unwrap_or(false);
     if !unknown {
         removed.extend(materials(scene));
         removed.extend(dedupe_images(scene)?);
@@ -78,7 +96,12 @@ fn attributes(scene: &mut Scene, keep_bitangents: bool) -> Result<Vec<Removal>> 
         let has_normal_tex = scene.normal_texcoord(r).is_some();
         let sets = used_sets(scene.material_of(r));
         let max_set = sets.iter().next_back().copied();
-        let names: Vec<String> = scene.prim_json(r).get("attributes").and_then(|a| a.as_object()).map(|a| a.keys().cloned().collect()).unwrap_or_default();
+        let names: Vec<String> = scene
+            .prim_json(r)
+            .get("attributes")
+            .and_then(|a| a.as_object())
+            .map(|a| a.keys().cloned().collect())
+            .unwrap_or_default();
         let mut drop = Vec::new();
         for name in names {
             let why = if name == "TANGENT" && !has_normal_tex {
@@ -106,7 +129,8 @@ fn attributes(scene: &mut Scene, keep_bitangents: bool) -> Result<Vec<Removal>> 
                     }
                 }
             }
-            let bytes = accessor_bytes(scene, idx) + target_idx.iter().map(|&i| accessor_bytes(scene, Some(i))).sum::<usize>();
+            let bytes =
+                accessor_bytes(scene, idx) + target_idx.iter().map(|&i| accessor_bytes(scene, Some(i))).sum::<usize>();
             out.push(Removal { what: format!("mesh {} primitive {}: {name} ({why})", r.mesh, r.primitive), bytes });
         }
     }
@@ -156,14 +180,22 @@ fn materials(scene: &mut Scene) -> Vec<Removal> {
         if let Some(m) = pj.get("material").and_then(|m| m.as_u64()) {
             keep.insert(m as usize);
         }
-        for mapping in pj.pointer("/extensions/KHR_materials_variants/mappings").and_then(|m| m.as_array()).into_iter().flatten() {
+        for mapping in
+            pj.pointer("/extensions/KHR_materials_variants/mappings").and_then(|m| m.as_array()).into_iter().flatten()
+        {
             if let Some(m) = mapping.get("material").and_then(|m| m.as_u64()) {
                 keep.insert(m as usize);
             }
         }
     }
     keep.retain(|&m| m < n);
-    let removed: Vec<Removal> = (0..n).filter(|i| !keep.contains(i)).map(|i| Removal { what: format!("material {i} {} (no primitive uses it)", name_of(scene, "materials", i)), bytes: 0 }).collect();
+    let removed: Vec<Removal> = (0..n)
+        .filter(|i| !keep.contains(i))
+        .map(|i| Removal {
+            what: format!("material {i} {} (no primitive uses it)", name_of(scene, "materials", i)),
+            bytes: 0,
+        })
+        .collect();
     if removed.is_empty() {
         return removed;
     }
@@ -173,7 +205,8 @@ fn materials(scene: &mut Scene) -> Vec<Removal> {
         if let Some(m) = pj.get_mut("material") {
             remap(m, &map);
         }
-        if let Some(list) = pj.pointer_mut("/extensions/KHR_materials_variants/mappings").and_then(|m| m.as_array_mut()) {
+        if let Some(list) = pj.pointer_mut("/extensions/KHR_materials_variants/mappings").and_then(|m| m.as_array_mut())
+        {
             for mapping in list {
                 if let Some(m) = mapping.get_mut("material") {
                     remap(m, &map);
@@ -185,7 +218,12 @@ fn materials(scene: &mut Scene) -> Vec<Removal> {
 }
 
 fn name_of(scene: &Scene, key: &str, i: usize) -> String {
-    scene.json.pointer(&format!("/{key}/{i}/name")).and_then(|n| n.as_str()).map(|n| format!("'{n}'")).unwrap_or_default()
+    scene
+        .json
+        .pointer(&format!("/{key}/{i}/name"))
+        .and_then(|n| n.as_str())
+        .map(|n| format!("'{n}'"))
+        .unwrap_or_default()
 }
 
 /// Image sources of a texture, including those of texture extensions.
@@ -211,7 +249,10 @@ fn dedupe_images(scene: &mut Scene) -> Result<Vec<Removal>> {
         match first.get(&bytes) {
             Some(&j) => {
                 map[i] = Some(j);
-                out.push(Removal { what: format!("image {i} {} (same bytes as image {j})", name_of(scene, "images", i)), bytes: bytes.len() });
+                out.push(Removal {
+                    what: format!("image {i} {} (same bytes as image {j})", name_of(scene, "images", i)),
+                    bytes: bytes.len(),
+                });
             }
             None => {
                 first.insert(bytes, i);
@@ -239,7 +280,11 @@ fn textures_images_samplers(scene: &mut Scene) -> Result<Vec<Removal>> {
         });
     }
     keep.retain(|&t| t < n);
-    out.extend((0..n).filter(|i| !keep.contains(i)).map(|i| Removal { what: format!("texture {i} (no material reads it)"), bytes: 0 }));
+    out.extend(
+        (0..n)
+            .filter(|i| !keep.contains(i))
+            .map(|i| Removal { what: format!("texture {i} (no material reads it)"), bytes: 0 }),
+    );
     let map = compact(scene, "textures", &keep);
     for m in scene.json.get_mut("materials").and_then(|m| m.as_array_mut()).into_iter().flatten() {
         texture_infos(m, &mut |t| remap(&mut t["index"], &map));
@@ -258,7 +303,10 @@ fn textures_images_samplers(scene: &mut Scene) -> Result<Vec<Removal>> {
     for i in (0..n).filter(|i| !keep.contains(i)) {
         if !out.iter().any(|r| r.what.starts_with(&format!("image {i} "))) {
             let bytes = scene.image_bytes(i).map(|b| b.len()).unwrap_or(0);
-            out.push(Removal { what: format!("image {i} {} (no texture shows it)", name_of(scene, "images", i)), bytes });
+            out.push(Removal {
+                what: format!("image {i} {} (no texture shows it)", name_of(scene, "images", i)),
+                bytes,
+            });
         }
     }
     let map = compact(scene, "images", &keep);
@@ -274,7 +322,11 @@ fn textures_images_samplers(scene: &mut Scene) -> Result<Vec<Removal>> {
         }
     }
     keep.retain(|&s| s < n);
-    out.extend((0..n).filter(|i| !keep.contains(i)).map(|i| Removal { what: format!("sampler {i} (no texture uses it)"), bytes: 0 }));
+    out.extend(
+        (0..n)
+            .filter(|i| !keep.contains(i))
+            .map(|i| Removal { what: format!("sampler {i} (no texture uses it)"), bytes: 0 }),
+    );
     let map = compact(scene, "samplers", &keep);
     for t in scene.json.get_mut("textures").and_then(|t| t.as_array_mut()).into_iter().flatten() {
         if let Some(s) = t.get_mut("sampler") {

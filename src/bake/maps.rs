@@ -20,7 +20,14 @@ pub struct HeightSettings {
 
 impl Default for HeightSettings {
     fn default() -> Self {
-        HeightSettings { strength: 1.0, filter: Filter::default(), invert: false, channel: Channel::Luma, max_pixels: normalmap::DEFAULT_MAX_PIXELS, sixteen_bit: false }
+        HeightSettings {
+            strength: 1.0,
+            filter: Filter::default(),
+            invert: false,
+            channel: Channel::Luma,
+            max_pixels: normalmap::DEFAULT_MAX_PIXELS,
+            sixteen_bit: false,
+        }
     }
 }
 
@@ -28,9 +35,15 @@ impl Default for HeightSettings {
 /// its base colour texture, else glTF's default (repeat). A map's filter must wrap the same way.
 pub fn material_wrap(scene: &Scene, material: usize) -> Wrap {
     let m = &scene.json["materials"][material];
-    let tex = m.pointer("/normalTexture/index").or_else(|| m.pointer("/pbrMetallicRoughness/baseColorTexture/index")).and_then(|t| t.as_u64());
+    let tex = m
+        .pointer("/normalTexture/index")
+        .or_else(|| m.pointer("/pbrMetallicRoughness/baseColorTexture/index"))
+        .and_then(|t| t.as_u64());
     let sampler = tex.and_then(|t| scene.json.pointer(&format!("/textures/{t}/sampler"))).and_then(|s| s.as_u64());
-    let mode = sampler.and_then(|s| scene.json.pointer(&format!("/samplers/{s}/wrapS"))).and_then(|w| w.as_u64()).unwrap_or(10497);
+    let mode = sampler
+        .and_then(|s| scene.json.pointer(&format!("/samplers/{s}/wrapS")))
+        .and_then(|w| w.as_u64())
+        .unwrap_or(10497);
     match mode {
         33071 => Wrap::Clamp,
         33648 => Wrap::Mirror,
@@ -42,7 +55,11 @@ pub fn material_wrap(scene: &Scene, material: usize) -> Wrap {
 pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings) -> Result<Vec<u8>> {
     let plane = normalmap::load_height(path, s.channel, s.max_pixels)?;
     let opts = Options { strength: s.strength * multiplier, filter: s.filter, wrap, invert: s.invert };
-    let enc = EncodeOptions { depth: if s.sixteen_bit { normalmap::Depth::Bits16 } else { normalmap::Depth::Bits8 }, convention: Convention::Opengl, alpha_height: false };
+    let enc = EncodeOptions {
+        depth: if s.sixteen_bit { normalmap::Depth::Bits16 } else { normalmap::Depth::Bits8 },
+        convention: Convention::Opengl,
+        alpha_height: false,
+    };
     let img = normalmap::encode_normals(&plane, &opts, &enc, None);
     normalmap::png_bytes(&img, PngSettings::default()).map_err(|e| Error::output(path, e))
 }
@@ -112,7 +129,10 @@ fn encode(img: image::DynamicImage) -> std::result::Result<Vec<u8>, String> {
 /// sampled like its base colour texture.
 pub fn attach(scene: &mut Scene, m: usize, png: &[u8], name: &str) {
     let img = scene.push_image(png, "image/png", Some(name));
-    let sampler = scene.json["materials"][m].pointer("/pbrMetallicRoughness/baseColorTexture/index").and_then(|t| t.as_u64()).and_then(|t| scene.json.pointer(&format!("/textures/{t}/sampler")).cloned());
+    let sampler = scene.json["materials"][m]
+        .pointer("/pbrMetallicRoughness/baseColorTexture/index")
+        .and_then(|t| t.as_u64())
+        .and_then(|t| scene.json.pointer(&format!("/textures/{t}/sampler")).cloned());
     let mut tex = serde_json::json!({ "source": img });
     if let Some(s) = sampler {
         tex["sampler"] = s;

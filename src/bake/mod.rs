@@ -71,8 +71,20 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
     let mut deps = scene.dependencies();
     ensure_material(&mut scene);
     let targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps))?;
-    let prims = t.time("tangents", || apply(&mut scene, &ApplyOptions { frames: crate::tangent::Options { bitangents: job.bitangents, ..Default::default() }, ..Default::default() }))?;
-    let removed = if job.keep_all { Vec::new() } else { t.time("leave-out", || leave_out::leave_out(&mut scene, job.bitangents))? };
+    let prims = t.time("tangents", || {
+        apply(
+            &mut scene,
+            &ApplyOptions {
+                frames: crate::tangent::Options { bitangents: job.bitangents, ..Default::default() },
+                ..Default::default()
+            },
+        )
+    })?;
+    let removed = if job.keep_all {
+        Vec::new()
+    } else {
+        t.time("leave-out", || leave_out::leave_out(&mut scene, job.bitangents))?
+    };
     let (mut files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &deps));
@@ -107,7 +119,14 @@ fn ensure_material(scene: &mut Scene) {
 }
 
 fn material_names(scene: &Scene) -> Vec<Option<String>> {
-    scene.json.get("materials").and_then(|m| m.as_array()).into_iter().flatten().map(|m| m.get("name").and_then(|n| n.as_str()).map(String::from)).collect()
+    scene
+        .json
+        .get("materials")
+        .and_then(|m| m.as_array())
+        .into_iter()
+        .flatten()
+        .map(|m| m.get("name").and_then(|n| n.as_str()).map(String::from))
+        .collect()
 }
 
 /// Decides which materials get which map, and attaches them.
@@ -120,7 +139,9 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
         })?),
         None => None,
     };
-    let wants_bump = |m: usize| scene.height_maps.iter().any(|h| h.material == m) || scene.json["materials"][m].get("normalTexture").is_some();
+    let wants_bump = |m: usize| {
+        scene.height_maps.iter().any(|h| h.material == m) || scene.json["materials"][m].get("normalTexture").is_some()
+    };
     let targets: Vec<usize> = match (chosen, &job.map) {
         (Some(m), _) => vec![m],
         (None, MapSource::Scene) => (0..names.len()).collect(),
@@ -128,7 +149,11 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
         (None, _) => {
             let t: Vec<usize> = (0..names.len()).filter(|&m| wants_bump(m)).collect();
             if t.is_empty() {
-                return Err(Error::usage(format!("{}: {} materials and none has a bump map; choose one with --material", job.mesh.display(), names.len())));
+                return Err(Error::usage(format!(
+                    "{}: {} materials and none has a bump map; choose one with --material",
+                    job.mesh.display(),
+                    names.len()
+                )));
             }
             t
         }
@@ -142,7 +167,9 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
             MapSource::Height(p) | MapSource::Normal(p) => {
                 if made.is_none() {
                     made = Some(match &job.map {
-                        MapSource::Height(_) => (maps::from_height(p, 1.0, maps::material_wrap(scene, m), &job.height)?, None),
+                        MapSource::Height(_) => {
+                            (maps::from_height(p, 1.0, maps::material_wrap(scene, m), &job.height)?, None)
+                        }
                         _ => {
                             let (b, c) = maps::from_normal(p, job.normal_convention, job.height.max_pixels)?;
                             (b, Some(c))
@@ -159,7 +186,13 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
                 if let Some(h) = scene.height_maps.iter().find(|h| h.material == m).cloned() {
                     let png = maps::from_height(&h.path, h.multiplier, maps::material_wrap(scene, m), &job.height)?;
                     maps::attach(scene, m, &png, &label);
-                    out.push(MaterialMap { material: m, name, source: "height", file: Some(h.path.clone()), convention: None });
+                    out.push(MaterialMap {
+                        material: m,
+                        name,
+                        source: "height",
+                        file: Some(h.path.clone()),
+                        convention: None,
+                    });
                 } else if scene.json["materials"][m].get("normalTexture").is_some() {
                     out.push(MaterialMap { material: m, name, source: "existing", file: None, convention: None });
                 }
@@ -179,7 +212,12 @@ impl BakeReport {
             let from = m.file.as_ref().map(|f| format!(" from {}", f.display())).unwrap_or_default();
             s += &format!("  material {} {}: {} map{from}", m.material, m.name.as_deref().unwrap_or(""), m.source);
             if let Some(c) = &m.convention {
-                s += &format!(" (looks {} at {:.2}{})", c.detected, c.confidence, if c.converted { ", converted to OpenGL +Y" } else { "" });
+                s += &format!(
+                    " (looks {} at {:.2}{})",
+                    c.detected,
+                    c.confidence,
+                    if c.converted { ", converted to OpenGL +Y" } else { "" }
+                );
             }
             s += "\n";
         }

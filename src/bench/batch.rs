@@ -79,7 +79,16 @@ pub fn run(exe: &Path, dir: &Path, n: usize, jobs: usize, runs: usize) -> Result
         }
         seq.push(t.elapsed().as_secs_f64() * 1e3);
         let t = Instant::now();
-        run_ok(Command::new(exe).arg("bake").args(&assets).arg("--out-dir").arg(&out).arg("-j").arg(jobs.to_string()).arg("-q"))?;
+        run_ok(
+            Command::new(exe)
+                .arg("bake")
+                .args(&assets)
+                .arg("--out-dir")
+                .arg(&out)
+                .arg("-j")
+                .arg(jobs.to_string())
+                .arg("-q"),
+        )?;
         par.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let (one_by_one_ms, batch_ms) = (median(seq), median(par));

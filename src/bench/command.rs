@@ -45,7 +45,8 @@ pub fn run(exe: &Path, input: &Path, dir: &Path, runs: usize) -> Result<CommandB
         if !o.status.success() {
             return Err(Error::usage(format!("bench command: tangents failed: {}", stderr.trim())));
         }
-        peak_kib = peak_kib.max(peak_of(&stderr).ok_or_else(|| Error::usage("bench command: no memory figures (is /proc mounted?)"))?);
+        peak_kib = peak_kib
+            .max(peak_of(&stderr).ok_or_else(|| Error::usage("bench command: no memory figures (is /proc mounted?)"))?);
     }
     let output_bytes = std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0);
     times.sort_by(f64::total_cmp);

@@ -6,8 +6,7 @@
 
 use super::surfaces::{self, Surface};
 use crate::normalmap::{
-    self as nm, Channel, Convert, Depth, EncodeOptions, Filter, HeightPlane, NormalImage, Options,
-    PngSettings, Wrap,
+    self as nm, Channel, Convert, Depth, EncodeOptions, Filter, HeightPlane, NormalImage, Options, PngSettings, Wrap,
 };
 use crate::{Error, Result};
 use rayon::prelude::*;
@@ -231,7 +230,8 @@ fn encoding_error(s: &Surface, exact: &[[f64; 3]]) -> Vec<EncodingRow> {
 /// A 16-bit relief of `n x n` from products of sines (table-driven, so it takes a moment
 /// even at 4096²), detailed at every scale like a scanned or sculpted height map.
 fn pipeline_heights(n: usize) -> Vec<u16> {
-    let waves: Vec<(f64, f64, f64)> = (0..12).map(|k| (2f64.powi(k / 2 + 1), 0.7 * k as f64, 2f64.powf(-(k as f64) * 0.6))).collect();
+    let waves: Vec<(f64, f64, f64)> =
+        (0..12).map(|k| (2f64.powi(k / 2 + 1), 0.7 * k as f64, 2f64.powf(-(k as f64) * 0.6))).collect();
     let total: f64 = waves.iter().map(|w| w.2).sum();
     let tables: Vec<Vec<f64>> = waves
         .iter()
@@ -364,11 +364,19 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
 pub fn render_text(r: &Report) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let _ = writeln!(s, "bench normalmap: {}x{} surfaces, wrap repeat, median of {} runs, {} threads", r.size, r.size, r.runs, r.threads);
+    let _ = writeln!(
+        s,
+        "bench normalmap: {}x{} surfaces, wrap repeat, median of {} runs, {} threads",
+        r.size, r.size, r.runs, r.threads
+    );
     for (name, what, strength) in &r.surfaces {
         let _ = writeln!(s, "  {name:<10} {what} (strength {strength:.3})");
     }
-    let _ = writeln!(s, "\n{:<10} {:<10} {:>9} {:>9} {:>9} {:>10} {:>10}", "filter", "surface", "mean°", "p99°", "max°", "Mpx/s", "Mpx/s 1t");
+    let _ = writeln!(
+        s,
+        "\n{:<10} {:<10} {:>9} {:>9} {:>9} {:>10} {:>10}",
+        "filter", "surface", "mean°", "p99°", "max°", "Mpx/s", "Mpx/s 1t"
+    );
     for row in &r.rows {
         let e = &row.error;
         let _ = writeln!(
@@ -386,13 +394,36 @@ pub fn render_text(r: &Report) -> String {
     let _ = writeln!(s, "\nencoding alone (exact normals, encoded and decoded):");
     for row in &r.encoding {
         let e = &row.error;
-        let _ = writeln!(s, "{:<10} {:<10} {:>9.4} {:>9.4} {:>9.4}", format!("{}-bit", row.bits), row.surface, e.mean_deg, e.p99_deg, e.max_deg);
+        let _ = writeln!(
+            s,
+            "{:<10} {:<10} {:>9.4} {:>9.4} {:>9.4}",
+            format!("{}-bit", row.bits),
+            row.surface,
+            e.mean_deg,
+            e.p99_deg,
+            e.max_deg
+        );
     }
     if let Some(p) = &r.pipeline {
-        let _ = writeln!(s, "\nwhole command on a {0}x{0} 16-bit PNG -> 8-bit RGB PNG (filter {1}), medians in ms:", p.size, p.filter.name());
-        let _ = writeln!(s, "  decode alone {:.1}, encode alone {:.1}, write alone {:.1}: baseline {:.1}", p.decode_ms, p.encode_ms, p.write_ms, p.baseline_ms);
+        let _ = writeln!(
+            s,
+            "\nwhole command on a {0}x{0} 16-bit PNG -> 8-bit RGB PNG (filter {1}), medians in ms:",
+            p.size,
+            p.filter.name()
+        );
+        let _ = writeln!(
+            s,
+            "  decode alone {:.1}, encode alone {:.1}, write alone {:.1}: baseline {:.1}",
+            p.decode_ms, p.encode_ms, p.write_ms, p.baseline_ms
+        );
         let stages: Vec<String> = p.command_stages.iter().map(|(n, t)| format!("{n} {t:.1}")).collect();
-        let _ = writeln!(s, "  whole command {:.1} ({}): ratio {:.3} (target <= 1.5)", p.command_ms, stages.join(", "), p.ratio);
+        let _ = writeln!(
+            s,
+            "  whole command {:.1} ({}): ratio {:.3} (target <= 1.5)",
+            p.command_ms,
+            stages.join(", "),
+            p.ratio
+        );
         let _ = writeln!(
             s,
             "  filter+encode-to-buffer {:.1} ms ({:.0} Mpx/s), one thread {:.1} ms ({:.0} Mpx/s, target >= 200)",
@@ -403,7 +434,11 @@ pub fn render_text(r: &Report) -> String {
         }
         let _ = writeln!(s, "  PNG settings for the 8-bit output:");
         for row in &p.png {
-            let _ = writeln!(s, "    {:<9} {:<9} {:>8.1} ms {:>11} bytes", row.compression, row.filter, row.encode_ms, row.bytes);
+            let _ = writeln!(
+                s,
+                "    {:<9} {:<9} {:>8.1} ms {:>11} bytes",
+                row.compression, row.filter, row.encode_ms, row.bytes
+            );
         }
     }
     s

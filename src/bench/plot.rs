@@ -27,26 +27,70 @@ pub fn error_vs_time_svg(r: &Report) -> String {
     let px = |v: f64| ml + (v.log10() - x0) / (x1 - x0) * (w - ml - mr);
     let py = |v: f64| h - mb - (v.log10() - y0) / (y1 - y0) * (h - mt - mb);
     let mut s = String::new();
-    let _ = writeln!(s, r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="11">"#);
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="11">"#
+    );
     let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = writeln!(s, r#"<text x="{}" y="18" text-anchor="middle" font-size="13">normal-map filters: mean angular error against time ({}x{})</text>"#, (ml + w - mr) / 2.0, r.size, r.size);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="18" text-anchor="middle" font-size="13">normal-map filters: mean angular error against time ({}x{})</text>"#,
+        (ml + w - mr) / 2.0,
+        r.size,
+        r.size
+    );
     for d in x0 as i32..=x1 as i32 {
         let x = px(10f64.powi(d));
-        let _ = writeln!(s, r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##, h - mb, h - mb + 15.0, 10f64.powi(d));
+        let _ = writeln!(
+            s,
+            r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
+            h - mb,
+            h - mb + 15.0,
+            10f64.powi(d)
+        );
     }
     for d in y0 as i32..=y1 as i32 {
         let y = py(10f64.powi(d));
-        let _ = writeln!(s, r##"<line x1="{ml}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##, w - mr, ml - 5.0, y + 4.0, 10f64.powi(d));
+        let _ = writeln!(
+            s,
+            r##"<line x1="{ml}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
+            w - mr,
+            ml - 5.0,
+            y + 4.0,
+            10f64.powi(d)
+        );
     }
-    let _ = writeln!(s, r#"<text x="{}" y="{}" text-anchor="middle">ns per pixel, one thread (filter + 8-bit encode)</text>"#, (ml + w - mr) / 2.0, h - 12.0);
-    let _ = writeln!(s, r#"<text transform="translate(16 {}) rotate(-90)" text-anchor="middle">mean error, degrees</text>"#, (mt + h - mb) / 2.0);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle">ns per pixel, one thread (filter + 8-bit encode)</text>"#,
+        (ml + w - mr) / 2.0,
+        h - 12.0
+    );
+    let _ = writeln!(
+        s,
+        r#"<text transform="translate(16 {}) rotate(-90)" text-anchor="middle">mean error, degrees</text>"#,
+        (mt + h - mb) / 2.0
+    );
     for (x, y, si, name) in &pts {
         let c = COLOURS[si % COLOURS.len()];
-        let _ = writeln!(s, r#"<circle cx="{:.1}" cy="{:.1}" r="4" fill="{c}"/><text x="{:.1}" y="{:.1}" fill="{c}" font-size="9">{name}</text>"#, px(*x), py(*y), px(*x) + 6.0, py(*y) + 3.0);
+        let _ = writeln!(
+            s,
+            r#"<circle cx="{:.1}" cy="{:.1}" r="4" fill="{c}"/><text x="{:.1}" y="{:.1}" fill="{c}" font-size="9">{name}</text>"#,
+            px(*x),
+            py(*y),
+            px(*x) + 6.0,
+            py(*y) + 3.0
+        );
     }
     for (i, (name, _, _)) in r.surfaces.iter().enumerate() {
         let (x, y) = (w - mr + 15.0, mt + 20.0 + 18.0 * i as f64);
-        let _ = writeln!(s, r#"<circle cx="{x}" cy="{y}" r="5" fill="{}"/><text x="{}" y="{}">{name}</text>"#, COLOURS[i % COLOURS.len()], x + 10.0, y + 4.0);
+        let _ = writeln!(
+            s,
+            r#"<circle cx="{x}" cy="{y}" r="5" fill="{}"/><text x="{}" y="{}">{name}</text>"#,
+            COLOURS[i % COLOURS.len()],
+            x + 10.0,
+            y + 4.0
+        );
     }
     s.push_str("</svg>\n");
     s

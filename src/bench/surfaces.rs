@@ -174,7 +174,17 @@ pub fn all(n: usize) -> Vec<Surface> {
         }
         .tuned(),
         fractal(n),
-        Surface { name: "fractal-16bit", what: "the fractal stored in 16 bits".into(), levels: Some(65535.0), ..fractal(n) },
-        Surface { name: "fractal-8bit", what: "the fractal stored in 8 bits (terracing)".into(), levels: Some(255.0), ..fractal(n) },
+        Surface {
+            name: "fractal-16bit",
+            what: "the fractal stored in 16 bits".into(),
+            levels: Some(65535.0),
+            ..fractal(n)
+        },
+        Surface {
+            name: "fractal-8bit",
+            what: "the fractal stored in 8 bits (terracing)".into(),
+            levels: Some(255.0),
+            ..fractal(n)
+        },
     ]
 }

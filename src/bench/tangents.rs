@@ -83,7 +83,15 @@ impl Case {
     pub fn from_file(path: &std::path::Path) -> crate::error::Result<Case> {
         let scene = crate::scene::Scene::read(path, &Default::default())?;
         let label = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let mut c = Case { surface: Surface::Mesh, positions: vec![], normals: vec![], uvs: vec![], indices: vec![], exact: vec![], label };
+        let mut c = Case {
+            surface: Surface::Mesh,
+            positions: vec![],
+            normals: vec![],
+            uvs: vec![],
+            indices: vec![],
+            exact: vec![],
+            label,
+        };
         for r in scene.primitives() {
             let p = crate::tangent::apply::to_triangle_list(scene.primitive(r)?);
             let Some(uv) = p.attr("TEXCOORD_0") else { continue };
@@ -486,9 +494,9 @@ pub fn table(r: &Report) -> String {
     for x in &r.rows {
         let speed = x.speedup_vs_reference.map_or("-".into(), |v| format!("{v:.2}"));
         let refmax = x.vs_reference.as_ref().map_or("-".into(), |v| format!("{:.2e}", v.max_deg));
-        let ident = x.identical_to_reference.map_or("-".into(), |v| {
-            format!("{:.2}%", 100.0 * v as f64 / (3 * x.triangles).max(1) as f64)
-        });
+        let ident = x
+            .identical_to_reference
+            .map_or("-".into(), |v| format!("{:.2}%", 100.0 * v as f64 / (3 * x.triangles).max(1) as f64));
         let ex = |f: fn(&ErrorStats) -> String| x.vs_exact.as_ref().map_or("-".into(), f);
         s += &format!(
             "{:<nw$} {:>9} {:<16} {:>10.2} {:>9.2} {:>8} {:>9} {:>9} {:>9} {:>6} {:>7} {:>10} {:>9}\n",

@@ -29,7 +29,18 @@ impl LogLog {
             (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
         }
         let (x0, y0) = (x0.floor(), y0.floor());
-        LogLog { w: 760.0, h: 480.0, ml: 70.0, mr, mt: 30.0, mb: 50.0, x0, x1: x1.ceil().max(x0 + 1.0), y0, y1: y1.ceil().max(y0 + 1.0) }
+        LogLog {
+            w: 760.0,
+            h: 480.0,
+            ml: 70.0,
+            mr,
+            mt: 30.0,
+            mb: 50.0,
+            x0,
+            x1: x1.ceil().max(x0 + 1.0),
+            y0,
+            y1: y1.ceil().max(y0 + 1.0),
+        }
     }
     fn px(&self, v: f64) -> f64 {
         self.ml + (v.log10() - self.x0) / (self.x1 - self.x0) * (self.w - self.ml - self.mr)
@@ -97,7 +108,11 @@ pub fn svg(r: &Report) -> String {
     let colour = |e: &str| if e == "fast" { "#d62728" } else { "#1f77b4" };
     let marker = |sf: Surface, x: f64, y: f64, c: &str| match sf {
         Surface::Sphere => format!("<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"4\" fill=\"{c}\" fill-opacity=\"0.7\"/>"),
-        Surface::Torus => format!("<rect x=\"{:.1}\" y=\"{:.1}\" width=\"8\" height=\"8\" fill=\"{c}\" fill-opacity=\"0.7\"/>", x - 4.0, y - 4.0),
+        Surface::Torus => format!(
+            "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"8\" height=\"8\" fill=\"{c}\" fill-opacity=\"0.7\"/>",
+            x - 4.0,
+            y - 4.0
+        ),
         Surface::WavyGrid => format!(
             "<path d=\"M{x:.1} {:.1} L{:.1} {:.1} L{:.1} {:.1} Z\" fill=\"{c}\" fill-opacity=\"0.7\"/>",
             y - 5.0,
@@ -106,7 +121,11 @@ pub fn svg(r: &Report) -> String {
             x - 5.0,
             y + 4.0
         ),
-        Surface::Fan => format!("<path d=\"M{:.1} {y:.1} h10 M{x:.1} {:.1} v10\" stroke=\"{c}\" stroke-width=\"2\"/>", x - 5.0, y - 5.0),
+        Surface::Fan => format!(
+            "<path d=\"M{:.1} {y:.1} h10 M{x:.1} {:.1} v10\" stroke=\"{c}\" stroke-width=\"2\"/>",
+            x - 5.0,
+            y - 5.0
+        ),
         // Meshes have no exact tangent, so no point on this plot.
         Surface::Mesh => String::new(),
     };
@@ -142,7 +161,6 @@ fn trim(v: f64) -> String {
     let s = format!("{v:.3}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
-
 
 /// Median time against triangle count, both on log axes, one line per surface and engine (each
 /// point a case), with a dotted line of slope 1 (time proportional to size) through the fast
@@ -180,7 +198,9 @@ pub fn scaling_svg(r: &Report) -> String {
     }
     // Slope 1 through the fast engine's largest case: where the points follow it, time is
     // proportional to size.
-    if let Some(&(t, ms)) = series.iter().filter(|(k, _)| k.ends_with(" fast")).flat_map(|(_, v)| v).max_by(|a, b| a.0.total_cmp(&b.0)) {
+    if let Some(&(t, ms)) =
+        series.iter().filter(|(k, _)| k.ends_with(" fast")).flat_map(|(_, v)| v).max_by(|a, b| a.0.total_cmp(&b.0))
+    {
         // Starts where it enters the plot: at the left edge or the bottom, whichever comes later.
         let t0 = 10f64.powf(x0).max(t * 10f64.powf(y0) / ms);
         s += &format!(

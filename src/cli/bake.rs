@@ -81,7 +81,14 @@ pub fn run(a: Args) -> Result<u8> {
             _ => MapSource::Scene,
         },
         material: a.material.clone(),
-        height: HeightSettings { strength, filter: a.filter, invert: a.invert, channel: a.channel, sixteen_bit: a.bits16, ..Default::default() },
+        height: HeightSettings {
+            strength,
+            filter: a.filter,
+            invert: a.invert,
+            channel: a.channel,
+            sixteen_bit: a.bits16,
+            ..Default::default()
+        },
         normal_convention: a.convention,
         keep_all: a.keep_all,
         bitangents: a.bitangents,
@@ -90,6 +97,8 @@ pub fn run(a: Args) -> Result<u8> {
         depfile: a.io.depfile.clone(),
     };
     let opts = a.batch.options();
-    let results = batch::run(&a.io.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input))))?;
+    let results = batch::run(&a.io.inputs, &opts, |input| {
+        run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
+    })?;
     super::report::print("bumpbake-bake/1", &a.io.inputs, results, a.batch.json, a.batch.quiet, BakeReport::text)
 }

@@ -2,8 +2,8 @@
 
 use super::{bench_batch, bench_command, bench_normalmap, bench_tangents};
 use bumpbake::{Error, Result};
-use std::path::Path;
 use clap::Subcommand;
+use std::path::Path;
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
@@ -39,7 +39,8 @@ pub fn run(args: Args) -> Result<u8> {
 /// Runs `f(bumpbake's own executable, a scratch folder)` for benchmark `what`, then removes the
 /// folder.
 pub(super) fn with_scratch<T>(what: &str, f: impl FnOnce(&Path, &Path) -> Result<T>) -> Result<T> {
-    let exe = std::env::current_exe().map_err(|e| Error::usage(format!("bench {what}: cannot find bumpbake itself: {e}")))?;
+    let exe =
+        std::env::current_exe().map_err(|e| Error::usage(format!("bench {what}: cannot find bumpbake itself: {e}")))?;
     let dir = std::env::temp_dir().join(format!("bumpbake-bench-{what}-{}", std::process::id()));
     let r = f(&exe, &dir);
     let _ = std::fs::remove_dir_all(&dir);

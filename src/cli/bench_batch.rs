@@ -22,7 +22,9 @@ pub struct BenchBatchArgs {
 }
 
 pub fn run(a: BenchBatchArgs) -> Result<u8> {
-    let r = super::bench::with_scratch("batch", |exe, dir| bumpbake::bench::batch::run(exe, dir, a.assets, a.jobs, a.runs))?;
+    let r = super::bench::with_scratch("batch", |exe, dir| {
+        bumpbake::bench::batch::run(exe, dir, a.assets, a.jobs, a.runs)
+    })?;
     super::bench::print(&r, a.json, |r| {
         format!(
             "{} assets: one process each {:.0} ms, one batch with -j {} {:.0} ms (medians of {}): ratio {:.2} (target <= 0.6)",

@@ -96,11 +96,7 @@ pub fn run(a: BenchTangentsArgs) -> Result<u8> {
         tangents::run(&opts, |row| {
             eprintln!(
                 "{:<10} {:>9} {:<16} {:>10.2} ms {:>8.2} Mtri/s",
-                row.name,
-                row.triangles,
-                row.engine,
-                row.median_ms,
-                row.mtriangles_per_s
+                row.name, row.triangles, row.engine, row.median_ms, row.mtriangles_per_s
             )
         })
     };

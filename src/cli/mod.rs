@@ -9,8 +9,8 @@ mod bench_tangents;
 mod completions;
 mod inspect;
 mod normalmap;
-mod report;
 mod preview;
+mod report;
 mod tangents;
 mod validate;
 

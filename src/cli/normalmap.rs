@@ -1,13 +1,11 @@
 //! `bumpbake normalmap HEIGHT -o NORMAL`: parses, checks the numbers, shows progress on a
 //! terminal, and hands the rest to `bumpbake::normalmap::convert_file`.
 
-use bumpbake::normalmap::{
-    self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap,
-};
+use bumpbake::batch;
+use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap};
 use bumpbake::{Error, Result};
 use clap::builder::TypedValueParser;
 use std::io::IsTerminal;
-use bumpbake::batch;
 use std::path::{Path, PathBuf};
 
 /// What alpha holds.
@@ -39,20 +37,10 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true, conflicts_with_all = ["height_range", "texel_size"])]
     pub strength: Option<f32>,
     /// Height of the full 0..1 sample range, in metres (with --texel-size: S = range / texel).
-    #[arg(
-        long,
-        value_name = "METRES",
-        allow_negative_numbers = true,
-        requires = "texel_size"
-    )]
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true, requires = "texel_size")]
     pub height_range: Option<f64>,
     /// Size of one texel, in metres.
-    #[arg(
-        long,
-        value_name = "METRES",
-        allow_negative_numbers = true,
-        requires = "height_range"
-    )]
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true, requires = "height_range")]
     pub texel_size: Option<f64>,
     /// Derivative filter (all estimate the true slope; see docs/normalmap.md).
     #[arg(long, value_enum, default_value_t = Filter::default())]
@@ -84,14 +72,10 @@ fn strength(args: &Args) -> Result<f32> {
         (Some(s), _, _) => s,
         (None, Some(range), Some(texel)) => {
             if !(texel.is_finite() && texel > 0.0) {
-                return Err(Error::usage(format!(
-                    "--texel-size {texel}: must be a positive length"
-                )));
+                return Err(Error::usage(format!("--texel-size {texel}: must be a positive length")));
             }
             if !(range.is_finite() && range >= 0.0) {
-                return Err(Error::usage(format!(
-                    "--height-range {range}: must be zero or a positive length"
-                )));
+                return Err(Error::usage(format!("--height-range {range}: must be zero or a positive length")));
             }
             Options::physical_strength(range, texel)
         }
@@ -115,12 +99,7 @@ struct Record {
 
 pub fn run(args: Args) -> Result<u8> {
     let outputs = super::report::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
-    let options = Options {
-        strength: strength(&args)?,
-        filter: args.filter,
-        wrap: args.wrap,
-        invert: args.invert,
-    };
+    let options = Options { strength: strength(&args)?, filter: args.filter, wrap: args.wrap, invert: args.invert };
     let convert = |input: &Path, output: &Path| -> Result<Convert> {
         let format = nm::OutputFormat::from_path(output)?;
         Ok(Convert {
@@ -146,7 +125,10 @@ pub fn run(args: Args) -> Result<u8> {
         vec![r]
     } else {
         let opts = args.batch.options();
-        batch::run(&args.heights, &opts, |input| convert(input, super::report::paired(&args.heights, &outputs, input)).and_then(|c| nm::convert_file(&c, None)))?
+        batch::run(&args.heights, &opts, |input| {
+            convert(input, super::report::paired(&args.heights, &outputs, input))
+                .and_then(|c| nm::convert_file(&c, None))
+        })?
     };
     let records: Vec<Result<Record>> = results
         .into_iter()
@@ -164,9 +146,7 @@ pub fn run(args: Args) -> Result<u8> {
 
 /// A bar on a terminal for maps big enough to wait for; nothing when piped or under CI.
 fn progress_bar(args: &Args) -> indicatif::ProgressBar {
-    let ci = std::env::var("CI")
-        .map(|v| v == "true" || v == "1")
-        .unwrap_or(false);
+    let ci = std::env::var("CI").map(|v| v == "true" || v == "1").unwrap_or(false);
     if args.batch.quiet || (!args.batch.progress && (ci || !std::io::stderr().is_terminal())) {
         return indicatif::ProgressBar::hidden();
     }
@@ -176,18 +156,14 @@ fn progress_bar(args: &Args) -> indicatif::ProgressBar {
         .ok()
         .and_then(|r| r.with_guessed_format().ok())
         .and_then(|r| r.into_dimensions().ok())
-        .filter(|(w, h)| {
-            (*w as u64) * (*h as u64) >= 4 << 20 && (*w as u64) * (*h as u64) <= args.max_pixels
-        });
+        .filter(|(w, h)| (*w as u64) * (*h as u64) >= 4 << 20 && (*w as u64) * (*h as u64) <= args.max_pixels);
     match rows {
         Some((_, h)) => {
             let bar = indicatif::ProgressBar::new(h as u64);
             bar.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "{msg} [{bar:40}] {pos}/{len} rows ({elapsed})",
-                )
-                .unwrap()
-                .progress_chars("=> "),
+                indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows ({elapsed})")
+                    .unwrap()
+                    .progress_chars("=> "),
             );
             bar.set_message(format!("normalmap {}", args.heights[0].display()));
             bar

@@ -94,7 +94,13 @@ pub enum DiffArg {
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
-    let p = |v: &str| v.trim().parse::<u32>().ok().filter(|&x| (1..=16384).contains(&x)).ok_or_else(|| format!("'{s}': sizes are 1 to 16384"));
+    let p = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&x| (1..=16384).contains(&x))
+            .ok_or_else(|| format!("'{s}': sizes are 1 to 16384"))
+    };
     Ok((p(w)?, p(h)?))
 }
 
@@ -106,7 +112,14 @@ pub fn run(a: Args) -> Result<u8> {
     if a.output.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("png")) != Some(true) {
         return Err(Error::usage(format!("{}: the preview is written as PNG; name it .png", a.output.display())));
     }
-    for (what, v) in [("--fov", a.fov), ("--ambient", a.ambient), ("--specular", a.specular), ("--shininess", a.shininess), ("--yaw", a.yaw), ("--pitch", a.pitch)] {
+    for (what, v) in [
+        ("--fov", a.fov),
+        ("--ambient", a.ambient),
+        ("--specular", a.specular),
+        ("--shininess", a.shininess),
+        ("--yaw", a.yaw),
+        ("--pitch", a.pitch),
+    ] {
         if !v.is_finite() || (what != "--yaw" && what != "--pitch" && v < 0.0) {
             return Err(Error::usage(format!("preview: {what} {v} is not a usable value")));
         }
@@ -116,7 +129,8 @@ pub fn run(a: Args) -> Result<u8> {
             return Err(Error::usage(format!("preview: --distance {d} must be positive")));
         }
     }
-    let lights = a.light.iter().map(|l| Light::parse(l)).collect::<std::result::Result<Vec<_>, _>>().map_err(Error::usage)?;
+    let lights =
+        a.light.iter().map(|l| Light::parse(l)).collect::<std::result::Result<Vec<_>, _>>().map_err(Error::usage)?;
     let view = match a.view {
         ViewArg::Shaded | ViewArg::Diff => View::Shaded,
         ViewArg::Normal => View::Normal,
@@ -141,7 +155,9 @@ pub fn run(a: Args) -> Result<u8> {
         let reference = match (&a.reference, &a.input) {
             (Some(r), None) => r,
             (None, Some(i)) => i,
-            (Some(_), Some(_)) => return Err(Error::usage("preview: give the reference either as IN or as --reference, not both")),
+            (Some(_), Some(_)) => {
+                return Err(Error::usage("preview: give the reference either as IN or as --reference, not both"))
+            }
             (None, None) => return Err(Error::usage("preview: --compare needs a reference (IN or --reference)")),
         };
         if a.view != ViewArg::Shaded && a.view != ViewArg::Diff {
@@ -162,10 +178,20 @@ pub fn run(a: Args) -> Result<u8> {
             });
             println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
         } else if !a.quiet {
-            eprintln!("preview: {} vs {} -> {} ({}x{}, {:.0} ms)", reference.display(), cand.display(), a.output.display(), cmp.width, cmp.height, ms);
+            eprintln!(
+                "preview: {} vs {} -> {} ({}x{}, {:.0} ms)",
+                reference.display(),
+                cand.display(),
+                a.output.display(),
+                cmp.width,
+                cmp.height,
+                ms
+            );
             eprintln!("  pixels compared {}, excluded near silhouettes {}", cmp.pixels_compared, cmp.pixels_excluded);
             match cmp.normal_angle_deg {
-                Some(s) => eprintln!("  shading-normal angle: mean {:.3}°, p95 {:.3}°, max {:.3}°", s.mean, s.p95, s.max),
+                Some(s) => {
+                    eprintln!("  shading-normal angle: mean {:.3}°, p95 {:.3}°, max {:.3}°", s.mean, s.p95, s.max)
+                }
                 None => eprintln!("  shading-normal angle: no pixels to compare"),
             }
             match cmp.psnr_db {
@@ -200,8 +226,23 @@ pub fn run(a: Args) -> Result<u8> {
         });
         println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
     } else if !a.quiet {
-        eprintln!("preview: {} -> {} ({}x{}, {} view, {} triangles, {:.0} ms)", input.display(), a.output.display(), opts.width, opts.height, opts.view.name(), prep.triangle_count(), ms);
-        eprintln!("  read {:.0} ms, prepare {:.0} ms, render {:.0} ms, write {:.0} ms", t_read, t_prep - t_read, t_render - t_prep, ms - t_render);
+        eprintln!(
+            "preview: {} -> {} ({}x{}, {} view, {} triangles, {:.0} ms)",
+            input.display(),
+            a.output.display(),
+            opts.width,
+            opts.height,
+            opts.view.name(),
+            prep.triangle_count(),
+            ms
+        );
+        eprintln!(
+            "  read {:.0} ms, prepare {:.0} ms, render {:.0} ms, write {:.0} ms",
+            t_read,
+            t_prep - t_read,
+            t_render - t_prep,
+            ms - t_render
+        );
         for n in &prep.notes {
             eprintln!("  note: {n}");
         }

@@ -62,7 +62,12 @@ impl BatchArgs {
 }
 
 /// Output paths for the inputs: `-o` for one input, or names derived into `--out-dir`.
-pub fn outputs(inputs: &[PathBuf], output: &Option<PathBuf>, out_dir: &Option<PathBuf>, ext: &str) -> Result<Vec<PathBuf>> {
+pub fn outputs(
+    inputs: &[PathBuf],
+    output: &Option<PathBuf>,
+    out_dir: &Option<PathBuf>,
+    ext: &str,
+) -> Result<Vec<PathBuf>> {
     let outs: Vec<PathBuf> = match (output, out_dir) {
         (Some(o), None) if inputs.len() == 1 => vec![o.clone()],
         (Some(_), None) => return Err(Error::usage("several inputs need --out-dir, not -o")),
@@ -78,7 +83,14 @@ pub fn outputs(inputs: &[PathBuf], output: &Option<PathBuf>, out_dir: &Option<Pa
 
 /// Prints every result; returns the exit code. `schema` names the record layout
 /// (`docs/json.md`). With one input its error is the command's error.
-pub fn print<R: serde::Serialize>(schema: &str, inputs: &[PathBuf], results: Vec<Result<R>>, json: bool, quiet: bool, text: impl Fn(&R) -> String) -> Result<u8> {
+pub fn print<R: serde::Serialize>(
+    schema: &str,
+    inputs: &[PathBuf],
+    results: Vec<Result<R>>,
+    json: bool,
+    quiet: bool,
+    text: impl Fn(&R) -> String,
+) -> Result<u8> {
     let single = inputs.len() == 1;
     let mut failed = Vec::new();
     for (input, r) in inputs.iter().zip(results) {
@@ -97,7 +109,10 @@ pub fn print<R: serde::Serialize>(schema: &str, inputs: &[PathBuf], results: Vec
             Err(e) if single => return Err(e),
             Err(e) => {
                 if json {
-                    println!("{}", serde_json::json!({ "schema": schema, "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() }));
+                    println!(
+                        "{}",
+                        serde_json::json!({ "schema": schema, "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() })
+                    );
                 }
                 if !quiet {
                     eprintln!("bumpbake: {e}");

@@ -53,11 +53,24 @@ pub fn run(a: Args) -> Result<u8> {
                 Normals::Smooth => NormalMode::Smooth,
             },
         },
-        apply: ApplyOptions { all: a.all, overwrite: a.overwrite, frames: Options { bitangents: a.bitangents, ..Default::default() } },
+        apply: ApplyOptions {
+            all: a.all,
+            overwrite: a.overwrite,
+            frames: Options { bitangents: a.bitangents, ..Default::default() },
+        },
         write: WriteOptions { embed: a.embed, ..Default::default() },
         depfile: a.io.depfile.clone(),
     };
     let opts = a.batch.options();
-    let results = batch::run(&a.io.inputs, &opts, |input| run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input))))?;
-    super::report::print("bumpbake-tangents/1", &a.io.inputs, results, a.batch.json, a.batch.quiet, TangentsReport::text)
+    let results = batch::run(&a.io.inputs, &opts, |input| {
+        run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
+    })?;
+    super::report::print(
+        "bumpbake-tangents/1",
+        &a.io.inputs,
+        results,
+        a.batch.json,
+        a.batch.quiet,
+        TangentsReport::text,
+    )
 }

@@ -67,7 +67,10 @@ pub fn run(a: Args) -> Result<u8> {
         return Ok(0);
     }
     if !(a.max_angle_deg.is_finite() && a.max_angle_deg >= 0.0) {
-        return Err(Error::usage(format!("--max-angle-deg must be a non-negative number of degrees, not {}", a.max_angle_deg)));
+        return Err(Error::usage(format!(
+            "--max-angle-deg must be a non-negative number of degrees, not {}",
+            a.max_angle_deg
+        )));
     }
     let opts = Options {
         max_angle_deg: a.max_angle_deg,

@@ -254,7 +254,14 @@ pub(crate) struct Strips<'a> {
 
 impl<'a> Strips<'a> {
     pub fn new(height: &'a HeightPlane, opts: &Options, enc: &EncodeOptions) -> Strips<'a> {
-        Strips { rows: rows::Rows::new(height, opts), height, opts: *opts, enc: *enc, u8s: Vec::new(), u16s: Vec::new() }
+        Strips {
+            rows: rows::Rows::new(height, opts),
+            height,
+            opts: *opts,
+            enc: *enc,
+            u8s: Vec::new(),
+            u16s: Vec::new(),
+        }
     }
     /// Encodes rows `y0..y0 + n` into `u8s` (8-bit) or `u16s` (16-bit).
     pub fn encode(&mut self, y0: usize, n: usize, progress: Progress) {
@@ -269,30 +276,14 @@ impl<'a> Strips<'a> {
 
 /// Encodes float normals (OpenGL convention, as [`NormalPlane`] holds them). `heights` fills
 /// alpha when `enc.alpha_height` is set (as given: invert it first if it is a depth map).
-pub fn encode_plane(
-    normals: &NormalPlane,
-    enc: &EncodeOptions,
-    heights: Option<&HeightPlane>,
-) -> NormalImage {
-    let enc = EncodeOptions {
-        alpha_height: enc.alpha_height && heights.is_some(),
-        ..*enc
-    };
+pub fn encode_plane(normals: &NormalPlane, enc: &EncodeOptions, heights: Option<&HeightPlane>) -> NormalImage {
+    let enc = EncodeOptions { alpha_height: enc.alpha_height && heights.is_some(), ..*enc };
     let data = match enc.depth {
         Depth::Bits8 => NormalData::U8(from_plane(normals, &enc, heights, 0u8, quantize8, alpha8)),
-        Depth::Bits16 => NormalData::U16(from_plane(
-            normals, &enc, heights, 0u16, quantize16, alpha16,
-        )),
-        Depth::Float => {
-            NormalData::F32(from_plane(normals, &enc, heights, 0f32, float_texel, |h| h))
-        }
+        Depth::Bits16 => NormalData::U16(from_plane(normals, &enc, heights, 0u16, quantize16, alpha16)),
+        Depth::Float => NormalData::F32(from_plane(normals, &enc, heights, 0f32, float_texel, |h| h)),
     };
-    NormalImage {
-        width: normals.width,
-        height: normals.height,
-        channels: channels(&enc),
-        data,
-    }
+    NormalImage { width: normals.width, height: normals.height, channels: channels(&enc), data }
 }
 
 fn from_plane<T: Copy + Send + Sync>(
@@ -311,9 +302,7 @@ fn from_plane<T: Copy + Send + Sync>(
         out.par_chunks_mut(w * ch).enumerate().for_each(|(y, row)| {
             let normal = |x: usize| normals.data[y * w + x];
             match heights {
-                Some(hp) if ch == 4 => {
-                    write_row::<_, 4>(row, ysign, normal, q, |x| qa(hp.data[y * w + x]))
-                }
+                Some(hp) if ch == 4 => write_row::<_, 4>(row, ysign, normal, q, |x| qa(hp.data[y * w + x])),
                 _ => write_row::<_, 3>(row, ysign, normal, q, |_| zero),
             }
         });
@@ -329,24 +318,17 @@ impl NormalImage {
         let ch = self.channels;
         let ys = convention.y_sign();
         let data = match &self.data {
-            NormalData::U8(d) => d
-                .chunks_exact(ch)
-                .map(|p| [decode8(p[0]), ys * decode8(p[1]), decode8(p[2])])
-                .collect(),
-            NormalData::U16(d) => d
-                .chunks_exact(ch)
-                .map(|p| [decode16(p[0]), ys * decode16(p[1]), decode16(p[2])])
-                .collect(),
-            NormalData::F32(d) => d
-                .chunks_exact(ch)
-                .map(|p| [2.0 * p[0] - 1.0, ys * (2.0 * p[1] - 1.0), 2.0 * p[2] - 1.0])
-                .collect(),
+            NormalData::U8(d) => {
+                d.chunks_exact(ch).map(|p| [decode8(p[0]), ys * decode8(p[1]), decode8(p[2])]).collect()
+            }
+            NormalData::U16(d) => {
+                d.chunks_exact(ch).map(|p| [decode16(p[0]), ys * decode16(p[1]), decode16(p[2])]).collect()
+            }
+            NormalData::F32(d) => {
+                d.chunks_exact(ch).map(|p| [2.0 * p[0] - 1.0, ys * (2.0 * p[1] - 1.0), 2.0 * p[2] - 1.0]).collect()
+            }
         };
-        NormalPlane {
-            width: self.width,
-            height: self.height,
-            data,
-        }
+        NormalPlane { width: self.width, height: self.height, data }
     }
 }
 
@@ -386,23 +368,12 @@ mod tests {
     #[test]
     fn plane_and_fused_encoders_agree() {
         let hp = HeightPlane::from_fn(9, 5, |x, y| ((x * 7 + y * 3) % 11) as f32 / 10.0);
-        let opts = Options {
-            strength: 3.0,
-            ..Options::default()
-        };
+        let opts = Options { strength: 3.0, ..Options::default() };
         for depth in [Depth::Bits8, Depth::Bits16, Depth::Float] {
             for convention in [Convention::Opengl, Convention::Directx] {
-                let enc = EncodeOptions {
-                    depth,
-                    convention,
-                    alpha_height: true,
-                };
+                let enc = EncodeOptions { depth, convention, alpha_height: true };
                 let fused = encode_normals(&hp, &opts, &enc, None);
-                let planed = encode_plane(
-                    &crate::normalmap::height_to_normal(&hp, &opts),
-                    &enc,
-                    Some(&hp),
-                );
+                let planed = encode_plane(&crate::normalmap::height_to_normal(&hp, &opts), &enc, Some(&hp));
                 assert_eq!(fused, planed);
             }
         }

@@ -44,10 +44,7 @@ pub(crate) struct RowScratch {
 
 impl RowScratch {
     pub fn new(width: usize, radius: usize) -> Self {
-        RowScratch {
-            smooth: vec![0.0; width + 2 * radius],
-            deriv: vec![0.0; width + 2 * radius],
-        }
+        RowScratch { smooth: vec![0.0; width + 2 * radius], deriv: vec![0.0; width + 2 * radius] }
     }
 }
 
@@ -142,31 +139,19 @@ fn pad(buf: &mut [f32], width: usize, r: usize, wrap: Wrap) {
 }
 
 /// Central difference `[-1, 0, 1] / 2`: the narrowest estimate, no smoothing.
-pub(crate) const CENTRAL: Kernel<1> = Kernel {
-    d: [-0.5, 0.0, 0.5, 0.0, 0.0],
-    s: [0.0, 1.0, 0.0, 0.0, 0.0],
-};
+pub(crate) const CENTRAL: Kernel<1> = Kernel { d: [-0.5, 0.0, 0.5, 0.0, 0.0], s: [0.0, 1.0, 0.0, 0.0, 0.0] };
 /// Fourth-order central difference `[1, -8, 0, 8, -1] / 12`: exact on cubics, so its error on
 /// smooth data falls as h^4 instead of h^2, for two more taps and no smoothing.
-pub(crate) const CENTRAL4: Kernel<2> = Kernel {
-    d: [1.0 / 12.0, -8.0 / 12.0, 0.0, 8.0 / 12.0, -1.0 / 12.0],
-    s: [0.0, 0.0, 1.0, 0.0, 0.0],
-};
+pub(crate) const CENTRAL4: Kernel<2> =
+    Kernel { d: [1.0 / 12.0, -8.0 / 12.0, 0.0, 8.0 / 12.0, -1.0 / 12.0], s: [0.0, 0.0, 1.0, 0.0, 0.0] };
 /// Sobel: central difference smoothed across by `[1, 2, 1] / 4`.
-pub(crate) const SOBEL: Kernel<1> = Kernel {
-    d: [-0.5, 0.0, 0.5, 0.0, 0.0],
-    s: [0.25, 0.5, 0.25, 0.0, 0.0],
-};
+pub(crate) const SOBEL: Kernel<1> = Kernel { d: [-0.5, 0.0, 0.5, 0.0, 0.0], s: [0.25, 0.5, 0.25, 0.0, 0.0] };
 /// Scharr: central difference smoothed by `[3, 10, 3] / 16`, tuned for rotational symmetry.
-pub(crate) const SCHARR: Kernel<1> = Kernel {
-    d: [-0.5, 0.0, 0.5, 0.0, 0.0],
-    s: [3.0 / 16.0, 10.0 / 16.0, 3.0 / 16.0, 0.0, 0.0],
-};
+pub(crate) const SCHARR: Kernel<1> =
+    Kernel { d: [-0.5, 0.0, 0.5, 0.0, 0.0], s: [3.0 / 16.0, 10.0 / 16.0, 3.0 / 16.0, 0.0, 0.0] };
 /// Prewitt: central difference averaged across by `[1, 1, 1] / 3`.
-pub(crate) const PREWITT: Kernel<1> = Kernel {
-    d: [-0.5, 0.0, 0.5, 0.0, 0.0],
-    s: [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0, 0.0],
-};
+pub(crate) const PREWITT: Kernel<1> =
+    Kernel { d: [-0.5, 0.0, 0.5, 0.0, 0.0], s: [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0, 0.0] };
 /// 5x5 Sobel: derivative `[-1, -2, 0, 2, 1] / 8` (Σ k·D = 1) and smoothing `[1, 4, 6, 4, 1] / 16`.
 pub(crate) const SOBEL5: Kernel<2> = Kernel {
     d: [-1.0 / 8.0, -2.0 / 8.0, 0.0, 2.0 / 8.0, 1.0 / 8.0],
@@ -177,35 +162,18 @@ pub(crate) const SOBEL5: Kernel<2> = Kernel {
 mod tests {
     use super::*;
 
-    fn grads<const R: usize>(
-        k: &Kernel<R>,
-        plane: &[f32],
-        w: usize,
-        h: usize,
-        wrap: Wrap,
-    ) -> (Vec<f32>, Vec<f32>) {
+    fn grads<const R: usize>(k: &Kernel<R>, plane: &[f32], w: usize, h: usize, wrap: Wrap) -> (Vec<f32>, Vec<f32>) {
         let mut s = RowScratch::new(w, R);
         let (mut gx, mut gy) = (vec![0.0; w * h], vec![0.0; w * h]);
         for y in 0..h {
-            k.row(
-                plane,
-                w,
-                h,
-                wrap,
-                y,
-                &mut s,
-                &mut gx[y * w..(y + 1) * w],
-                &mut gy[y * w..(y + 1) * w],
-            );
+            k.row(plane, w, h, wrap, y, &mut s, &mut gx[y * w..(y + 1) * w], &mut gy[y * w..(y + 1) * w]);
         }
         (gx, gy)
     }
 
     /// h = a·x + b·y_up, with y_up = h - 1 - row.
     fn ramp(w: usize, h: usize, a: f32, b: f32) -> Vec<f32> {
-        (0..w * h)
-            .map(|i| a * (i % w) as f32 + b * (h - 1 - i / w) as f32)
-            .collect()
+        (0..w * h).map(|i| a * (i % w) as f32 + b * (h - 1 - i / w) as f32).collect()
     }
 
     fn check_ramp<const R: usize>(k: &Kernel<R>) {
@@ -215,16 +183,8 @@ mod tests {
         // Interior texels (at least R from every edge) see the ramp's exact slope.
         for y in R..h - R {
             for x in R..w - R {
-                assert!(
-                    (gx[y * w + x] - 0.03).abs() < 1e-6,
-                    "gx {} at {x},{y}",
-                    gx[y * w + x]
-                );
-                assert!(
-                    (gy[y * w + x] + 0.02).abs() < 1e-6,
-                    "gy {} at {x},{y}",
-                    gy[y * w + x]
-                );
+                assert!((gx[y * w + x] - 0.03).abs() < 1e-6, "gx {} at {x},{y}", gx[y * w + x]);
+                assert!((gy[y * w + x] + 0.02).abs() < 1e-6, "gy {} at {x},{y}", gy[y * w + x]);
             }
         }
     }
@@ -279,9 +239,7 @@ mod tests {
     fn repeat_differentiates_across_the_seam() {
         // A periodic sawtooth-free signal: repeat sees the wrap neighbour, clamp does not.
         let (w, h) = (8, 1);
-        let plane: Vec<f32> = (0..w)
-            .map(|x| (x as f32 * std::f32::consts::TAU / 8.0).sin())
-            .collect();
+        let plane: Vec<f32> = (0..w).map(|x| (x as f32 * std::f32::consts::TAU / 8.0).sin()).collect();
         let (gr, _) = grads(&CENTRAL, &plane, w, h, Wrap::Repeat);
         let (gc, _) = grads(&CENTRAL, &plane, w, h, Wrap::Clamp);
         let expect0 = (plane[1] - plane[7]) / 2.0;

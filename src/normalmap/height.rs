@@ -31,22 +31,12 @@ pub struct HeightPlane {
 impl HeightPlane {
     pub fn new(width: usize, height: usize, data: Vec<f32>) -> HeightPlane {
         assert_eq!(data.len(), width * height, "height plane size");
-        HeightPlane {
-            width,
-            height,
-            data,
-        }
+        HeightPlane { width, height, data }
     }
     /// `f(x, row)` for every texel, row 0 at the top.
     pub fn from_fn(width: usize, height: usize, f: impl Fn(usize, usize) -> f32) -> HeightPlane {
-        let data = (0..width * height)
-            .map(|i| f(i % width, i / width))
-            .collect();
-        HeightPlane {
-            width,
-            height,
-            data,
-        }
+        let data = (0..width * height).map(|i| f(i % width, i / width)).collect();
+        HeightPlane { width, height, data }
     }
     pub fn get(&self, x: usize, y: usize) -> f32 {
         self.data[y * self.width + x]
@@ -153,12 +143,8 @@ mod tests {
     #[test]
     fn bit_depths_scale_to_unit_range() {
         let g8 = DynamicImage::ImageLuma8(GrayImage::from_raw(2, 1, vec![0, 255]).unwrap());
-        assert_eq!(
-            height_from_image(&g8, Channel::Luma).unwrap().data,
-            vec![0.0, 1.0]
-        );
-        let g16: ImageBuffer<Luma<u16>, Vec<u16>> =
-            ImageBuffer::from_raw(2, 1, vec![1, 65535]).unwrap();
+        assert_eq!(height_from_image(&g8, Channel::Luma).unwrap().data, vec![0.0, 1.0]);
+        let g16: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_raw(2, 1, vec![1, 65535]).unwrap();
         let p = height_from_image(&DynamicImage::ImageLuma16(g16), Channel::R).unwrap();
         assert_eq!(p.data, vec![1.0 / 65535.0, 1.0]);
     }
@@ -172,15 +158,12 @@ mod tests {
         assert_eq!(height_from_image(&img, Channel::G).unwrap().data[0], 0.0);
         assert_eq!(height_from_image(&img, Channel::A).unwrap().data[0], 0.2);
         let gray = DynamicImage::ImageLuma8(GrayImage::new(1, 1));
-        assert!(height_from_image(&gray, Channel::A)
-            .unwrap_err()
-            .contains("no alpha"));
+        assert!(height_from_image(&gray, Channel::A).unwrap_err().contains("no alpha"));
     }
 
     #[test]
     fn non_finite_floats_are_refused() {
-        let img =
-            image::Rgb32FImage::from_raw(2, 1, vec![0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0]).unwrap();
+        let img = image::Rgb32FImage::from_raw(2, 1, vec![0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0]).unwrap();
         let e = height_from_image(&DynamicImage::ImageRgb32F(img), Channel::R).unwrap_err();
         assert!(e.contains("column 1, row 0"), "{e}");
     }

@@ -1,10 +1,7 @@
 //! Files in and out. Inputs are refused on their header's size before any pixel buffer is
 //! allocated; outputs are written whole or not at all ([`crate::output::write_atomic`]).
 
-use super::{
-    encode_normals, height_from_image, Channel, Depth, EncodeOptions, HeightPlane, NormalData,
-    NormalImage,
-};
+use super::{encode_normals, height_from_image, Channel, Depth, EncodeOptions, HeightPlane, NormalData, NormalImage};
 use super::{Convention, NormalPlane, Options, Progress};
 use crate::error::{Error, Result};
 use crate::report::Timings;
@@ -17,19 +14,14 @@ pub const DEFAULT_MAX_PIXELS: u64 = 268_435_456;
 
 /// One line, however the decoder formats its error.
 fn one_line(e: impl std::fmt::Display) -> String {
-    e.to_string()
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ")
+    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Opens and decodes an image, refusing it first if its header claims more than `max_pixels`.
 pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
-    let reader = ImageReader::open(path)
-        .map_err(|e| Error::input(path, format!("cannot open: {}", one_line(e))))?;
-    let mut reader = reader
-        .with_guessed_format()
-        .map_err(|e| Error::input(path, format!("cannot read: {}", one_line(e))))?;
+    let reader = ImageReader::open(path).map_err(|e| Error::input(path, format!("cannot open: {}", one_line(e))))?;
+    let mut reader =
+        reader.with_guessed_format().map_err(|e| Error::input(path, format!("cannot read: {}", one_line(e))))?;
     if reader.format().is_none() {
         return Err(Error::input(path, "not a PNG, TIFF or EXR image"));
     }
@@ -44,13 +36,10 @@ pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
         Some(image::ImageFormat::OpenExr) => "cannot decode as EXR".to_string(),
         other => format!("cannot decode as {other:?}"),
     };
-    let decoder = reader
-        .into_decoder()
-        .map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
+    let decoder = reader.into_decoder().map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
     let (w, h) = decoder.dimensions();
     check_size(path, w, h, max_pixels)?;
-    DynamicImage::from_decoder(decoder)
-        .map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))
+    DynamicImage::from_decoder(decoder).map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))
 }
 
 /// Reads a height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA, palette), TIFF, or EXR.
@@ -161,30 +150,15 @@ pub fn load_normal_image(path: &Path, max_pixels: u64) -> Result<NormalImage> {
         DynamicImage::ImageRgb32F(b) => (3, NormalData::F32(b.into_raw())),
         DynamicImage::ImageRgba32F(b) => (4, NormalData::F32(b.into_raw())),
         other => {
-            return Err(Error::input(
-                path,
-                format!(
-                    "a normal map must be RGB or RGBA, this is {:?}",
-                    other.color()
-                ),
-            ))
+            return Err(Error::input(path, format!("a normal map must be RGB or RGBA, this is {:?}", other.color())))
         }
     };
-    Ok(NormalImage {
-        width,
-        height,
-        channels,
-        data,
-    })
+    Ok(NormalImage { width, height, channels, data })
 }
 
 /// Reads a normal map and decodes it to vectors (`n = 2·texel - 1`, OpenGL convention,
 /// not renormalised). `convention` is the one the file was written in.
-pub fn decode_normal_image(
-    path: &Path,
-    convention: Convention,
-    max_pixels: u64,
-) -> Result<NormalPlane> {
+pub fn decode_normal_image(path: &Path, convention: Convention, max_pixels: u64) -> Result<NormalPlane> {
     Ok(load_normal_image(path, max_pixels)?.decode(convention))
 }
 
@@ -198,28 +172,23 @@ pub enum OutputFormat {
 
 impl OutputFormat {
     pub fn from_path(path: &Path) -> Result<OutputFormat> {
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
+        let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
         match ext.as_str() {
             "png" => Ok(OutputFormat::Png),
             "tif" | "tiff" => Ok(OutputFormat::Tiff),
             "exr" => Ok(OutputFormat::Exr),
-            _ => Err(Error::usage(format!(
-                "{}: unsupported output format: name it .png, .tif or .exr",
-                path.display()
-            ))),
+            _ => {
+                Err(Error::usage(format!("{}: unsupported output format: name it .png, .tif or .exr", path.display())))
+            }
         }
     }
     /// The sample depth for `--bits` (None: the format's default).
     pub fn depth(self, path: &Path, bits: Option<u8>) -> Result<Depth> {
         match (self, bits) {
             (OutputFormat::Exr, None) => Ok(Depth::Float),
-            (OutputFormat::Exr, Some(_)) => Err(Error::usage(format!(
-                "{}: EXR output is 32-bit float; --bits is for PNG and TIFF",
-                path.display()
-            ))),
+            (OutputFormat::Exr, Some(_)) => {
+                Err(Error::usage(format!("{}: EXR output is 32-bit float; --bits is for PNG and TIFF", path.display())))
+            }
             (_, None | Some(8)) => Ok(Depth::Bits8),
             (_, Some(16)) => Ok(Depth::Bits16),
             (_, Some(b)) => Err(Error::usage(format!("--bits {b}: use 8 or 16"))),
@@ -237,10 +206,7 @@ pub struct PngSettings {
 
 impl Default for PngSettings {
     fn default() -> Self {
-        PngSettings {
-            compression: png::Compression::Fast,
-            filter: png::Filter::Up,
-        }
+        PngSettings { compression: png::Compression::Fast, filter: png::Filter::Up }
     }
 }
 
@@ -248,11 +214,7 @@ impl Default for PngSettings {
 pub fn png_bytes(img: &NormalImage, settings: PngSettings) -> std::result::Result<Vec<u8>, String> {
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, img.width as u32, img.height as u32);
-    enc.set_color(if img.channels == 4 {
-        png::ColorType::Rgba
-    } else {
-        png::ColorType::Rgb
-    });
+    enc.set_color(if img.channels == 4 { png::ColorType::Rgba } else { png::ColorType::Rgb });
     enc.set_compression(settings.compression);
     enc.set_filter(settings.filter);
     let result = match &img.data {
@@ -271,65 +233,39 @@ pub fn png_bytes(img: &NormalImage, settings: PngSettings) -> std::result::Resul
                 w.finish()
             })
         }
-        NormalData::F32(_) => {
-            return Err("a float normal map cannot be written as PNG: use .exr".into())
-        }
+        NormalData::F32(_) => return Err("a float normal map cannot be written as PNG: use .exr".into()),
     };
     result.map_err(one_line)?;
     Ok(out)
 }
 
-fn image_bytes(
-    img: &NormalImage,
-    format: OutputFormat,
-    png: PngSettings,
-) -> std::result::Result<Vec<u8>, String> {
+fn image_bytes(img: &NormalImage, format: OutputFormat, png: PngSettings) -> std::result::Result<Vec<u8>, String> {
     let (w, h) = (img.width as u32, img.height as u32);
     let rgba = img.channels == 4;
     match (format, &img.data) {
         (OutputFormat::Png, _) => png_bytes(img, png),
         (OutputFormat::Tiff, NormalData::U8(d)) => {
             let mut c = Cursor::new(Vec::new());
-            let ct = if rgba {
-                ExtendedColorType::Rgba8
-            } else {
-                ExtendedColorType::Rgb8
-            };
-            image::codecs::tiff::TiffEncoder::new(&mut c)
-                .write_image(d, w, h, ct)
-                .map_err(one_line)?;
+            let ct = if rgba { ExtendedColorType::Rgba8 } else { ExtendedColorType::Rgb8 };
+            image::codecs::tiff::TiffEncoder::new(&mut c).write_image(d, w, h, ct).map_err(one_line)?;
             Ok(c.into_inner())
         }
         (OutputFormat::Tiff, NormalData::U16(d)) => {
             let mut c = Cursor::new(Vec::new());
-            let ct = if rgba {
-                ExtendedColorType::Rgba16
-            } else {
-                ExtendedColorType::Rgb16
-            };
+            let ct = if rgba { ExtendedColorType::Rgba16 } else { ExtendedColorType::Rgb16 };
             let bytes: Vec<u8> = d.iter().flat_map(|v| v.to_ne_bytes()).collect();
-            image::codecs::tiff::TiffEncoder::new(&mut c)
-                .write_image(&bytes, w, h, ct)
-                .map_err(one_line)?;
+            image::codecs::tiff::TiffEncoder::new(&mut c).write_image(&bytes, w, h, ct).map_err(one_line)?;
             Ok(c.into_inner())
         }
         (OutputFormat::Exr, NormalData::F32(d)) => {
             let mut c = Cursor::new(Vec::new());
-            let ct = if rgba {
-                ExtendedColorType::Rgba32F
-            } else {
-                ExtendedColorType::Rgb32F
-            };
+            let ct = if rgba { ExtendedColorType::Rgba32F } else { ExtendedColorType::Rgb32F };
             let bytes: Vec<u8> = d.iter().flat_map(|v| v.to_ne_bytes()).collect();
-            image::codecs::openexr::OpenExrEncoder::new(&mut c)
-                .write_image(&bytes, w, h, ct)
-                .map_err(one_line)?;
+            image::codecs::openexr::OpenExrEncoder::new(&mut c).write_image(&bytes, w, h, ct).map_err(one_line)?;
             Ok(c.into_inner())
         }
         (OutputFormat::Exr, _) => Err("EXR output takes float normals".into()),
-        (OutputFormat::Tiff, NormalData::F32(_)) => {
-            Err("float TIFF output is not supported: use .exr".into())
-        }
+        (OutputFormat::Tiff, NormalData::F32(_)) => Err("float TIFF output is not supported: use .exr".into()),
     }
 }
 

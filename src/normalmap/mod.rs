@@ -29,8 +29,8 @@ pub use encode::{
 pub use filter::wrap_index;
 pub use height::{height_from_image, Channel, HeightPlane};
 pub use io::{
-    convert_file, decode_normal_image, load_height, load_normal_image, open_image, png_bytes,
-    write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
+    convert_file, decode_normal_image, load_height, load_normal_image, open_image, png_bytes, write_normal_image,
+    Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
 pub use rows::{unit_normal, Progress};
 
@@ -130,12 +130,7 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options {
-            strength: 1.0,
-            filter: Filter::default(),
-            wrap: Wrap::default(),
-            invert: false,
-        }
+        Options { strength: 1.0, filter: Filter::default(), wrap: Wrap::default(), invert: false }
     }
 }
 
@@ -169,24 +164,24 @@ impl NormalPlane {
 }
 
 /// Float unit normals for every texel of `height` (OpenGL convention).
-pub fn normals_from_height(
-    height: &HeightPlane,
-    opts: &Options,
-    progress: Progress,
-) -> NormalPlane {
+pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: Progress) -> NormalPlane {
     let (w, h) = (height.width, height.height);
     let mut data = vec![[0.0f32; 3]; w * h];
     let s = opts.signed_strength();
-    rows::for_each_row(height, opts, &mut data, w, progress, || (), |_, _, gx, gy, out, _| {
-        for ((o, &dx), &dy) in out.iter_mut().zip(gx).zip(gy) {
-            *o = unit_normal(dx, dy, s);
-        }
-    });
-    NormalPlane {
-        width: w,
-        height: h,
-        data,
-    }
+    rows::for_each_row(
+        height,
+        opts,
+        &mut data,
+        w,
+        progress,
+        || (),
+        |_, _, gx, gy, out, _| {
+            for ((o, &dx), &dy) in out.iter_mut().zip(gx).zip(gy) {
+                *o = unit_normal(dx, dy, s);
+            }
+        },
+    );
+    NormalPlane { width: w, height: h, data }
 }
 
 /// The name other commands use: [`normals_from_height`] without progress.

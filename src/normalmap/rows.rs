@@ -64,9 +64,7 @@ impl<'a> Source<'a> {
             Filter::Prewitt => Source::R1(filter::PREWITT),
             Filter::Central4 => Source::R2(filter::CENTRAL4),
             Filter::Sobel5 => Source::R2(filter::SOBEL5),
-            Filter::Spectral => {
-                Source::Spectral(Spectral::new(&h.data, h.width, h.height, opts.wrap))
-            }
+            Filter::Spectral => Source::Spectral(Spectral::new(&h.data, h.width, h.height, opts.wrap)),
         }
     }
     fn scratch(&self, width: usize) -> Scratch {

@@ -37,11 +37,7 @@ struct Line {
 
 impl Line {
     fn new(n: usize, wrap: Wrap, planner: &mut FftPlanner<f32>) -> Line {
-        let len = if wrap == Wrap::Repeat || n == 1 {
-            n
-        } else {
-            2 * n
-        };
+        let len = if wrap == Wrap::Repeat || n == 1 { n } else { 2 * n };
         let fwd = planner.plan_fft_forward(len);
         let inv = planner.plan_fft_inverse(len);
         let mult = (0..len)
@@ -51,25 +47,12 @@ impl Line {
                 if 2 * k == len {
                     return 0.0;
                 }
-                let f = if 2 * k < len {
-                    k as f64
-                } else {
-                    k as f64 - len as f64
-                };
+                let f = if 2 * k < len { k as f64 } else { k as f64 - len as f64 };
                 (std::f64::consts::TAU * f / len as f64 / len as f64) as f32
             })
             .collect();
-        let scratch_len = fwd
-            .get_inplace_scratch_len()
-            .max(inv.get_inplace_scratch_len());
-        Line {
-            n,
-            len,
-            fwd,
-            inv,
-            mult,
-            scratch_len,
-        }
+        let scratch_len = fwd.get_inplace_scratch_len().max(inv.get_inplace_scratch_len());
+        Line { n, len, fwd, inv, mult, scratch_len }
     }
 
     /// Writes the line `a` (real part) and `b` (imaginary part) into `buf`, extended as planned,
@@ -122,10 +105,7 @@ impl Line {
     }
 
     fn buffers(&self) -> (Vec<Complex32>, Vec<Complex32>) {
-        (
-            vec![Complex32::default(); self.len],
-            vec![Complex32::default(); self.scratch_len],
-        )
+        (vec![Complex32::default(); self.len], vec![Complex32::default(); self.scratch_len])
     }
 }
 
@@ -152,45 +132,36 @@ impl<'a> Spectral<'a> {
         let cols = Line::new(height, wrap, &mut planner);
         let nblocks = width.div_ceil(BLOCK);
         let mut gy_blocks = vec![0.0f32; nblocks * height * BLOCK];
-        gy_blocks
-            .par_chunks_mut(height * BLOCK)
-            .enumerate()
-            .for_each(|(b, out)| {
-                let (mut buf, mut scratch) = cols.buffers();
-                let x0 = b * BLOCK;
-                let ncols = BLOCK.min(width - x0);
-                for pair in (0..ncols).step_by(2) {
-                    let (xa, xb) = (x0 + pair, x0 + pair + 1);
-                    let has_b = pair + 1 < ncols;
-                    // Row index y is y_up = height-1-y, so feed the column bottom-up.
-                    let slope = cols.fill(
-                        &mut buf,
-                        |i| plane[(height - 1 - i) * width + xa],
-                        |i| {
-                            if has_b {
-                                plane[(height - 1 - i) * width + xb]
-                            } else {
-                                0.0
-                            }
-                        },
-                    );
-                    cols.differentiate(&mut buf, &mut scratch);
-                    for i in 0..height {
-                        let y = height - 1 - i;
-                        out[y * BLOCK + pair] = buf[i].re + slope.re;
+        gy_blocks.par_chunks_mut(height * BLOCK).enumerate().for_each(|(b, out)| {
+            let (mut buf, mut scratch) = cols.buffers();
+            let x0 = b * BLOCK;
+            let ncols = BLOCK.min(width - x0);
+            for pair in (0..ncols).step_by(2) {
+                let (xa, xb) = (x0 + pair, x0 + pair + 1);
+                let has_b = pair + 1 < ncols;
+                // Row index y is y_up = height-1-y, so feed the column bottom-up.
+                let slope = cols.fill(
+                    &mut buf,
+                    |i| plane[(height - 1 - i) * width + xa],
+                    |i| {
                         if has_b {
-                            out[y * BLOCK + pair + 1] = buf[i].im + slope.im;
+                            plane[(height - 1 - i) * width + xb]
+                        } else {
+                            0.0
                         }
+                    },
+                );
+                cols.differentiate(&mut buf, &mut scratch);
+                for i in 0..height {
+                    let y = height - 1 - i;
+                    out[y * BLOCK + pair] = buf[i].re + slope.re;
+                    if has_b {
+                        out[y * BLOCK + pair + 1] = buf[i].im + slope.im;
                     }
                 }
-            });
-        Spectral {
-            plane,
-            width,
-            rows,
-            gy_blocks,
-            height,
-        }
+            }
+        });
+        Spectral { plane, width, rows, gy_blocks, height }
     }
 
     pub fn scratch(&self) -> SpectralScratch {
@@ -222,12 +193,7 @@ mod tests {
         let mut sc = s.scratch();
         let (mut gx, mut gy) = (vec![0.0; w * h], vec![0.0; w * h]);
         for y in 0..h {
-            s.row(
-                y,
-                &mut sc,
-                &mut gx[y * w..(y + 1) * w],
-                &mut gy[y * w..(y + 1) * w],
-            );
+            s.row(y, &mut sc, &mut gx[y * w..(y + 1) * w], &mut gy[y * w..(y + 1) * w]);
         }
         (gx, gy)
     }
@@ -238,9 +204,7 @@ mod tests {
         for (w, h) in [(16, 8), (13, 7), (17, 31), (1, 9)] {
             let (fx, fy) = (3.0 / w as f64, 2.0 / h as f64);
             let hgt = |x: f64, yu: f64| 0.5 + 0.2 * (TAU * (fx * x + fy * yu)).sin();
-            let plane: Vec<f32> = (0..w * h)
-                .map(|i| hgt((i % w) as f64, (h - 1 - i / w) as f64) as f32)
-                .collect();
+            let plane: Vec<f32> = (0..w * h).map(|i| hgt((i % w) as f64, (h - 1 - i / w) as f64) as f32).collect();
             let s = Spectral::new(&plane, w, h, Wrap::Repeat);
             let (gx, gy) = all_grads(&s, w, h);
             for i in 0..w * h {
@@ -249,17 +213,8 @@ mod tests {
                 // A 1-wide image has only the zero frequency along x, like any sampled signal.
                 let ex = if w == 1 { 0.0 } else { c * fx };
                 let fy_eff = if 2 * 2 >= h { 0.0 } else { fy };
-                assert!(
-                    (gx[i] as f64 - ex).abs() < 1e-4,
-                    "{w}x{h} gx {} vs {ex}",
-                    gx[i]
-                );
-                assert!(
-                    (gy[i] as f64 - c * fy_eff).abs() < 1e-4,
-                    "{w}x{h} gy {} vs {}",
-                    gy[i],
-                    c * fy
-                );
+                assert!((gx[i] as f64 - ex).abs() < 1e-4, "{w}x{h} gx {} vs {ex}", gx[i]);
+                assert!((gy[i] as f64 - c * fy_eff).abs() < 1e-4, "{w}x{h} gy {} vs {}", gy[i], c * fy);
             }
         }
     }

@@ -79,7 +79,9 @@ pub fn mask(a: &Frame, b: &Frame) -> Vec<bool> {
                 }
                 let j = idx(nx, ny);
                 for f in [a, b] {
-                    if full(f, i) != full(f, j) || (full(f, i) && (f.depth[i] - f.depth[j]).abs() > DEPTH_JUMP * f.depth[i]) {
+                    if full(f, i) != full(f, j)
+                        || (full(f, i) && (f.depth[i] - f.depth[j]).abs() > DEPTH_JUMP * f.depth[i])
+                    {
                         e = true;
                     }
                 }
@@ -128,7 +130,14 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     let ok = mask(a, b);
     let mut angles = Vec::new();
     let mut se = 0.0f64;
-    let mut diff = Frame { width: a.width, height: a.height, rgb: Vec::new(), normal: Vec::new(), coverage: Vec::new(), depth: Vec::new() };
+    let mut diff = Frame {
+        width: a.width,
+        height: a.height,
+        rgb: Vec::new(),
+        normal: Vec::new(),
+        coverage: Vec::new(),
+        depth: Vec::new(),
+    };
     let mut excluded = 0;
     let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as f64;
     for i in 0..ok.len() {
@@ -165,5 +174,15 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     });
     let mse = if n > 0 { se / (3 * n) as f64 } else { 0.0 };
     let psnr = (mse > 0.0).then(|| 10.0 * (255.0f64 * 255.0 / mse).log10());
-    (Comparison { width: a.width, height: a.height, pixels_compared: n, pixels_excluded: excluded, normal_angle_deg: stats, psnr_db: psnr }, diff)
+    (
+        Comparison {
+            width: a.width,
+            height: a.height,
+            pixels_compared: n,
+            pixels_excluded: excluded,
+            normal_angle_deg: stats,
+            psnr_db: psnr,
+        },
+        diff,
+    )
 }

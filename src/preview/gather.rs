@@ -37,7 +37,13 @@ pub struct Material {
 
 impl Default for Material {
     fn default() -> Self {
-        Material { base_color: Vec4::ONE, base_texture: None, normal_texture: None, normal_scale: 1.0, double_sided: false }
+        Material {
+            base_color: Vec4::ONE,
+            base_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            double_sided: false,
+        }
     }
 }
 
@@ -80,11 +86,23 @@ impl Prepared {
     /// [`Prepared::new`], and `all_frames` also generates MikkTSpace tangents for primitives
     /// whose material has no normal map (for the tangent, bitangent and handedness views).
     pub fn with_frames(scene: &Scene, all_frames: bool) -> Result<Prepared> {
-        let mut cx = Cx { scene, all_frames, textures: HashMap::new(), materials: Vec::new(), material_index: HashMap::new(), notes: Vec::new() };
+        let mut cx = Cx {
+            scene,
+            all_frames,
+            textures: HashMap::new(),
+            materials: Vec::new(),
+            material_index: HashMap::new(),
+            notes: Vec::new(),
+        };
         let mut draws = Vec::new();
         let mut prim_cache: HashMap<PrimRef, Option<Local>> = HashMap::new();
         for (mesh, world) in instances(scene) {
-            let n = scene.json.pointer(&format!("/meshes/{mesh}/primitives")).and_then(|p| p.as_array()).map(|a| a.len()).unwrap_or(0);
+            let n = scene
+                .json
+                .pointer(&format!("/meshes/{mesh}/primitives"))
+                .and_then(|p| p.as_array())
+                .map(|a| a.len())
+                .unwrap_or(0);
             for p in 0..n {
                 let r = PrimRef { mesh, primitive: p };
                 if !prim_cache.contains_key(&r) {
@@ -162,15 +180,25 @@ impl Cx<'_> {
             // Exactly what `bumpbake tangents` would store, so the preview shows the tool's frames.
             prim = crate::tangent::primitive_with_tangents(prim, uv_set, s.uv_v_up, &Default::default());
             if has_map {
-                self.notes.push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));
+                self.notes
+                    .push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));
             }
         }
         let mut positions: Vec<Vec3> = prim.positions().into_iter().map(Vec3::from).collect();
-        let mut normals: Option<Vec<Vec3>> = prim.attr("NORMAL").map(|n| n.to_f32::<3>().into_iter().map(Vec3::from).collect());
-        let mut tangents: Option<Vec<Vec4>> = prim.attr("TANGENT").filter(|t| t.format.components() == 4).map(|t| t.to_f32::<4>().into_iter().map(Vec4::from).collect());
+        let mut normals: Option<Vec<Vec3>> =
+            prim.attr("NORMAL").map(|n| n.to_f32::<3>().into_iter().map(Vec3::from).collect());
+        let mut tangents: Option<Vec<Vec4>> = prim
+            .attr("TANGENT")
+            .filter(|t| t.format.components() == 4)
+            .map(|t| t.to_f32::<4>().into_iter().map(Vec4::from).collect());
         let uv = |k: u32| -> Vec<Vec2> {
             prim.attr(&format!("TEXCOORD_{k}"))
-                .map(|t| t.to_f32::<2>().into_iter().map(|[u, v]| if s.uv_v_up { Vec2::new(u, 1.0 - v) } else { Vec2::new(u, v) }).collect())
+                .map(|t| {
+                    t.to_f32::<2>()
+                        .into_iter()
+                        .map(|[u, v]| if s.uv_v_up { Vec2::new(u, 1.0 - v) } else { Vec2::new(u, v) })
+                        .collect()
+                })
                 .unwrap_or_default()
         };
         let mut uvs = [uv(0), uv(1)];
@@ -181,7 +209,13 @@ impl Cx<'_> {
             // glTF: a client must use flat normals, so every corner becomes its own vertex.
             let corner_pos: Vec<[f32; 3]> = indices.iter().map(|&i| positions[i as usize].to_array()).collect();
             let (n, _) = flat_normals(&corner_pos);
-            let gather3 = |v: &Vec<Vec2>| if v.is_empty() { Vec::new() } else { indices.iter().map(|&i| v[i as usize]).collect() };
+            let gather3 = |v: &Vec<Vec2>| {
+                if v.is_empty() {
+                    Vec::new()
+                } else {
+                    indices.iter().map(|&i| v[i as usize]).collect()
+                }
+            };
             uvs = [gather3(&uvs[0]), gather3(&uvs[1])];
             tangents = tangents.map(|t| indices.iter().map(|&i| t[i as usize]).collect());
             positions = corner_pos.into_iter().map(Vec3::from).collect();
@@ -239,13 +273,20 @@ impl Cx<'_> {
     fn tex_ref(&mut self, info: &Value, srgb: bool) -> Result<Option<TexRef>> {
         let s = self.scene;
         let Some(ti) = info.get("index").and_then(|i| i.as_u64()) else { return Ok(None) };
-        let tj = s.json.pointer(&format!("/textures/{ti}")).ok_or_else(|| s.err(format!("texture {ti} does not exist")))?;
+        let tj =
+            s.json.pointer(&format!("/textures/{ti}")).ok_or_else(|| s.err(format!("texture {ti} does not exist")))?;
         let Some(img) = tj.get("source").and_then(|i| i.as_u64()).map(|i| i as usize) else {
             self.notes.push(format!("texture {ti} has no PNG/JPEG source; drawn without it"));
             return Ok(None);
         };
-        let sampler = Sampler::from_json(tj.get("sampler").and_then(|i| i.as_u64()).and_then(|i| s.json.pointer(&format!("/samplers/{i}"))));
-        let texcoord = info.pointer("/extensions/KHR_texture_transform/texCoord").or_else(|| info.get("texCoord")).and_then(|t| t.as_u64()).unwrap_or(0);
+        let sampler = Sampler::from_json(
+            tj.get("sampler").and_then(|i| i.as_u64()).and_then(|i| s.json.pointer(&format!("/samplers/{i}"))),
+        );
+        let texcoord = info
+            .pointer("/extensions/KHR_texture_transform/texCoord")
+            .or_else(|| info.get("texCoord"))
+            .and_then(|t| t.as_u64())
+            .unwrap_or(0);
         if texcoord > 1 {
             self.notes.push(format!("texture {ti} reads TEXCOORD_{texcoord}; only sets 0 and 1 are drawn"));
             return Ok(None);
@@ -272,8 +313,14 @@ fn image_bytes(s: &Scene, img: usize) -> Result<Vec<u8>> {
     if let Some(uri) = ij.get("uri").and_then(|u| u.as_str()) {
         return crate::scene::uri::read(uri, &s.base_dir, &s.source, s.allow_outside);
     }
-    let bv = ij.get("bufferView").and_then(|b| b.as_u64()).ok_or_else(|| s.err(format!("image {img} has neither uri nor bufferView")))?;
-    let v = s.json.pointer(&format!("/bufferViews/{bv}")).ok_or_else(|| s.err(format!("image {img}: bufferView {bv} does not exist")))?;
+    let bv = ij
+        .get("bufferView")
+        .and_then(|b| b.as_u64())
+        .ok_or_else(|| s.err(format!("image {img} has neither uri nor bufferView")))?;
+    let v = s
+        .json
+        .pointer(&format!("/bufferViews/{bv}"))
+        .ok_or_else(|| s.err(format!("image {img}: bufferView {bv} does not exist")))?;
     let b = v.get("buffer").and_then(|b| b.as_u64()).unwrap_or(0) as usize;
     let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
     let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
@@ -291,7 +338,10 @@ fn instances(scene: &Scene) -> Vec<(usize, Mat4)> {
     let roots: Vec<usize> = if let Some(sc) = j.get("scenes").and_then(|s| s.as_array()).filter(|s| !s.is_empty()) {
         let si = j.get("scene").and_then(|s| s.as_u64()).unwrap_or(0) as usize;
         let sc = sc.get(si).or(sc.first());
-        sc.and_then(|s| s.get("nodes")).and_then(|n| n.as_array()).map(|a| a.iter().filter_map(|x| x.as_u64()).map(|x| x as usize).collect()).unwrap_or_default()
+        sc.and_then(|s| s.get("nodes"))
+            .and_then(|n| n.as_array())
+            .map(|a| a.iter().filter_map(|x| x.as_u64()).map(|x| x as usize).collect())
+            .unwrap_or_default()
     } else if !nodes.is_empty() {
         let mut child = vec![false; nodes.len()];
         for n in nodes {
@@ -318,7 +368,14 @@ fn instances(scene: &Scene) -> Vec<(usize, Mat4)> {
         if let Some(m) = node.get("mesh").and_then(|m| m.as_u64()) {
             out.push((m as usize, world));
         }
-        let children: Vec<usize> = node.get("children").and_then(|c| c.as_array()).into_iter().flatten().filter_map(|c| c.as_u64()).map(|c| c as usize).collect();
+        let children: Vec<usize> = node
+            .get("children")
+            .and_then(|c| c.as_array())
+            .into_iter()
+            .flatten()
+            .filter_map(|c| c.as_u64())
+            .map(|c| c as usize)
+            .collect();
         for c in children.into_iter().rev() {
             stack.push((c, world, depth + 1));
         }
@@ -337,7 +394,10 @@ fn local_matrix(node: &Value) -> Mat4 {
         return Mat4::from_cols_slice(&m);
     }
     let t = floats(node.get("translation"), 3).map(|v| Vec3::from_slice(&v)).unwrap_or(Vec3::ZERO);
-    let r = floats(node.get("rotation"), 4).map(|v| Quat::from_slice(&v).normalize()).filter(|q| q.is_finite()).unwrap_or(Quat::IDENTITY);
+    let r = floats(node.get("rotation"), 4)
+        .map(|v| Quat::from_slice(&v).normalize())
+        .filter(|q| q.is_finite())
+        .unwrap_or(Quat::IDENTITY);
     let s = floats(node.get("scale"), 3).map(|v| Vec3::from_slice(&v)).unwrap_or(Vec3::ONE);
     Mat4::from_scale_rotation_translation(s, r, t)
 }

@@ -48,7 +48,15 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options { width: 512, height: 512, ssaa: 1, camera: CameraSpec::default(), lights: Vec::new(), view: View::Shaded, params: Params::default() }
+        Options {
+            width: 512,
+            height: 512,
+            ssaa: 1,
+            camera: CameraSpec::default(),
+            lights: Vec::new(),
+            view: View::Shaded,
+            params: Params::default(),
+        }
     }
 }
 
@@ -63,7 +71,10 @@ impl Options {
         }
         let n = self.width as u64 * self.height as u64 * (self.ssaa as u64).pow(2);
         if n > MAX_SAMPLES {
-            return Err(crate::Error::usage(format!("preview: {}x{} with --ssaa {} is {n} samples; the limit is {MAX_SAMPLES}", self.width, self.height, self.ssaa)));
+            return Err(crate::Error::usage(format!(
+                "preview: {}x{} with --ssaa {} is {n} samples; the limit is {MAX_SAMPLES}",
+                self.width, self.height, self.ssaa
+            )));
         }
         Ok(())
     }
@@ -159,7 +170,14 @@ pub fn render(prep: &Prepared, cam: &Camera, opts: &Options) -> Frame {
         })
         .collect();
     let px = rows.into_iter().flatten();
-    let mut frame = Frame { width: opts.width, height: opts.height, rgb: Vec::new(), normal: Vec::new(), coverage: Vec::new(), depth: Vec::new() };
+    let mut frame = Frame {
+        width: opts.width,
+        height: opts.height,
+        rgb: Vec::new(),
+        normal: Vec::new(),
+        coverage: Vec::new(),
+        depth: Vec::new(),
+    };
     for (c, n, cov, d) in px {
         frame.rgb.push(c.to_array());
         frame.normal.push(n);

@@ -69,7 +69,8 @@ const TILE: u32 = 32;
 /// Rasterises every draw as `cam` sees it into a `width` x `height` sample grid.
 pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u32, height: u32) -> Raster {
     let (wf, hf) = (width as f32, height as f32);
-    let clip: Vec<Vec<Vec4>> = draws.par_iter().map(|d| d.positions.par_iter().map(|&p| cam.clip(p)).collect()).collect();
+    let clip: Vec<Vec<Vec4>> =
+        draws.par_iter().map(|d| d.positions.par_iter().map(|&p| cam.clip(p)).collect()).collect();
     let prims: Vec<Prim> = draws
         .par_iter()
         .enumerate()
@@ -79,7 +80,8 @@ pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u3
             d.triangles.par_iter().enumerate().flat_map_iter(move |(ti, t)| {
                 let c = [clip[t[0] as usize], clip[t[1] as usize], clip[t[2] as usize]];
                 setup(c, wf, hf).into_iter().filter_map(move |(v, sub)| {
-                    let area = (v[1][0] - v[0][0]) as f64 * (v[2][1] - v[0][1]) as f64 - (v[2][0] - v[0][0]) as f64 * (v[1][1] - v[0][1]) as f64;
+                    let area = (v[1][0] - v[0][0]) as f64 * (v[2][1] - v[0][1]) as f64
+                        - (v[2][0] - v[0][0]) as f64 * (v[1][1] - v[0][1]) as f64;
                     // Screen y points down, so glTF's counter-clockwise front faces have area < 0.
                     let back = area > 0.0;
                     if area == 0.0 || !area.is_finite() || (back && !two_sided) {
@@ -106,7 +108,14 @@ pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u3
         .enumerate()
         .map(|(k, bin)| {
             let (bx, by) = (k as u32 % tx, k as u32 / tx);
-            raster_tile(&prims, bin, bx * TILE, by * TILE, (bx * TILE + TILE).min(width), (by * TILE + TILE).min(height))
+            raster_tile(
+                &prims,
+                bin,
+                bx * TILE,
+                by * TILE,
+                (bx * TILE + TILE).min(width),
+                (by * TILE + TILE).min(height),
+            )
         })
         .collect();
     let mut samples = vec![NONE; (width * height) as usize];
@@ -126,8 +135,10 @@ pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u3
 fn pixel_box(p: &Prim, width: u32, height: u32) -> Option<(u32, u32, u32, u32)> {
     let xs = [p.v[0][0], p.v[1][0], p.v[2][0]];
     let ys = [p.v[0][1], p.v[1][1], p.v[2][1]];
-    let (minx, maxx) = (xs.iter().cloned().fold(f32::INFINITY, f32::min), xs.iter().cloned().fold(f32::NEG_INFINITY, f32::max));
-    let (miny, maxy) = (ys.iter().cloned().fold(f32::INFINITY, f32::min), ys.iter().cloned().fold(f32::NEG_INFINITY, f32::max));
+    let (minx, maxx) =
+        (xs.iter().cloned().fold(f32::INFINITY, f32::min), xs.iter().cloned().fold(f32::NEG_INFINITY, f32::max));
+    let (miny, maxy) =
+        (ys.iter().cloned().fold(f32::INFINITY, f32::min), ys.iter().cloned().fold(f32::NEG_INFINITY, f32::max));
     // Sample centres are at +0.5: the first centre >= min is ceil(min - 0.5).
     let x0 = (minx - 0.5).ceil().max(0.0);
     let y0 = (miny - 0.5).ceil().max(0.0);
@@ -191,7 +202,13 @@ fn setup(c: [Vec4; 3], w: f32, h: f32) -> Vec<Piece> {
         return Vec::new();
     }
     let out = |f: &dyn Fn(Vec4) -> bool| c.iter().all(|&v| f(v));
-    if out(&|v| v.x > v.w) || out(&|v| v.x < -v.w) || out(&|v| v.y > v.w) || out(&|v| v.y < -v.w) || out(&|v| v.z > v.w) || out(&|v| v.z < -v.w) {
+    if out(&|v| v.x > v.w)
+        || out(&|v| v.x < -v.w)
+        || out(&|v| v.y > v.w)
+        || out(&|v| v.y < -v.w)
+        || out(&|v| v.z > v.w)
+        || out(&|v| v.z < -v.w)
+    {
         return Vec::new();
     }
     let screen = |v: Vec4| -> [f32; 4] {

@@ -32,12 +32,23 @@ impl Light {
     /// by `@intensity`.
     pub fn parse(s: &str) -> Result<Light, String> {
         let (body, intensity) = match s.rsplit_once('@') {
-            Some((b, i)) => (b, i.trim().parse::<f32>().ok().filter(|x| x.is_finite() && *x >= 0.0).ok_or_else(|| format!("light '{s}': bad intensity '{i}'"))?),
+            Some((b, i)) => (
+                b,
+                i.trim()
+                    .parse::<f32>()
+                    .ok()
+                    .filter(|x| x.is_finite() && *x >= 0.0)
+                    .ok_or_else(|| format!("light '{s}': bad intensity '{i}'"))?,
+            ),
             None => (s, 1.0),
         };
         let color = Vec3::splat(intensity);
         let vec = |t: &str| -> Result<Vec3, String> {
-            let v: Vec<f32> = t.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| format!("light '{s}': '{t}' is not x,y,z"))?;
+            let v: Vec<f32> = t
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| format!("light '{s}': '{t}' is not x,y,z"))?;
             if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
                 return Err(format!("light '{s}': '{t}' is not three finite numbers x,y,z"));
             }
@@ -54,7 +65,12 @@ impl Light {
             }
             ["point", p] => Ok(Light::Point { pos: vec(p)?, color }),
             ["spot", p, d, a] => {
-                let angle: f32 = a.trim().parse().ok().filter(|x: &f32| x.is_finite() && *x > 0.0 && *x <= 180.0).ok_or_else(|| format!("light '{s}': cone angle '{a}' is not in (0, 180] degrees"))?;
+                let angle: f32 = a
+                    .trim()
+                    .parse()
+                    .ok()
+                    .filter(|x: &f32| x.is_finite() && *x > 0.0 && *x <= 180.0)
+                    .ok_or_else(|| format!("light '{s}': cone angle '{a}' is not in (0, 180] degrees"))?;
                 let dir = vec(d)?;
                 if dir.length_squared() == 0.0 {
                     return Err(format!("light '{s}': spot direction is zero"));
@@ -107,7 +123,10 @@ pub fn default_lights(eye: Vec3, target: Vec3) -> Vec<Light> {
     let up = right.cross(fwd);
     let key = (-right * 0.5 + up * 0.6 - fwd * 0.75).normalize();
     let fill = (right * 0.8 - up * 0.1 - fwd * 0.6).normalize();
-    vec![Light::Directional { dir: -key, color: Vec3::splat(0.9) }, Light::Directional { dir: -fill, color: Vec3::splat(0.25) }]
+    vec![
+        Light::Directional { dir: -key, color: Vec3::splat(0.9) },
+        Light::Directional { dir: -fill, color: Vec3::splat(0.25) },
+    ]
 }
 
 /// What a fragment needs from its triangle.

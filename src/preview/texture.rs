@@ -56,7 +56,11 @@ impl Sampler {
     /// The sampler a glTF `samplers[i]` object describes (absent fields take glTF's defaults).
     pub fn from_json(s: Option<&serde_json::Value>) -> Sampler {
         let get = |k: &str| s.and_then(|s| s.get(k)).and_then(|v| v.as_u64());
-        Sampler { wrap_s: Wrap::from_gl(get("wrapS")), wrap_t: Wrap::from_gl(get("wrapT")), nearest: get("magFilter") == Some(9728) }
+        Sampler {
+            wrap_s: Wrap::from_gl(get("wrapS")),
+            wrap_t: Wrap::from_gl(get("wrapT")),
+            nearest: get("magFilter") == Some(9728),
+        }
     }
 }
 

@@ -139,7 +139,9 @@ impl Stream {
         match (self.format.component_type, self.format.components()) {
             (UNSIGNED_BYTE, 1) => self.data.iter().map(|&b| b as u32).collect(),
             (UNSIGNED_SHORT, 1) => self.data.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]]) as u32).collect(),
-            (UNSIGNED_INT, 1) => self.data.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect(),
+            (UNSIGNED_INT, 1) => {
+                self.data.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
+            }
             _ => (0..self.len()).map(|i| self.get(i, 0) as u32).collect(),
         }
     }
@@ -191,9 +193,17 @@ mod tests {
     #[test]
     fn indices_above_two_to_the_24_are_exact() {
         let big = [16_777_217u32, u32::MAX - 1, 7];
-        let s = Stream { format: Format { component_type: UNSIGNED_INT, ty: "SCALAR".into(), normalized: false }, data: big.iter().flat_map(|i| i.to_le_bytes()).collect(), template: None };
+        let s = Stream {
+            format: Format { component_type: UNSIGNED_INT, ty: "SCALAR".into(), normalized: false },
+            data: big.iter().flat_map(|i| i.to_le_bytes()).collect(),
+            template: None,
+        };
         assert_eq!(s.to_u32(), big);
-        let s = Stream { format: Format { component_type: UNSIGNED_SHORT, ty: "SCALAR".into(), normalized: false }, data: vec![0xff, 0xff, 1, 0], template: None };
+        let s = Stream {
+            format: Format { component_type: UNSIGNED_SHORT, ty: "SCALAR".into(), normalized: false },
+            data: vec![0xff, 0xff, 1, 0],
+            template: None,
+        };
         assert_eq!(s.to_u32(), [65535, 1]);
     }
 
@@ -203,7 +213,11 @@ mod tests {
         assert_eq!(f.to_f32::<3>(), [[1.5, -0.0, 3e38], [f32::MIN_POSITIVE, 2.0, -7.25]]);
         assert_eq!(f.to_f32::<2>(), [[1.5, -0.0], [f32::MIN_POSITIVE, 2.0]]);
         assert_eq!(f.to_f32::<4>(), [[1.5, -0.0, 3e38, 0.0], [f32::MIN_POSITIVE, 2.0, -7.25, 0.0]]);
-        let n = Stream { format: Format { component_type: UNSIGNED_BYTE, ty: "VEC2".into(), normalized: true }, data: vec![255, 0, 51, 102], template: None };
+        let n = Stream {
+            format: Format { component_type: UNSIGNED_BYTE, ty: "VEC2".into(), normalized: true },
+            data: vec![255, 0, 51, 102],
+            template: None,
+        };
         assert_eq!(n.to_f32::<2>(), [[1.0, 0.0], [0.2, 0.4]]);
         assert_eq!(&*n.as_f32::<2>(), [[1.0, 0.0], [0.2, 0.4]]);
         assert_eq!(&*f.as_f32::<3>(), &*f.to_f32::<3>());

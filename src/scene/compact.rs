@@ -101,7 +101,12 @@ pub(super) struct Dangling(pub usize, pub usize);
 
 /// Drops the entries of `json[key]` that `refs` does not find (none with `keep_all`) and
 /// renumbers the references; returns how many went. Changes nothing when a reference dangles.
-pub(super) fn drop_unreferenced(json: &mut Value, key: &str, keep_all: bool, refs: fn(&mut Value, &mut dyn FnMut(&mut usize)) -> BTreeSet<usize>) -> Result<usize, Dangling> {
+pub(super) fn drop_unreferenced(
+    json: &mut Value,
+    key: &str,
+    keep_all: bool,
+    refs: fn(&mut Value, &mut dyn FnMut(&mut usize)) -> BTreeSet<usize>,
+) -> Result<usize, Dangling> {
     let n = json.get(key).and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0);
     let keep: BTreeSet<usize> = if keep_all { (0..n).collect() } else { refs(json, &mut |_| {}) };
     if let Some(&i) = keep.iter().next_back().filter(|&&i| i >= n) {
@@ -175,7 +180,9 @@ mod tests {
             b1.extend_from_slice(&[0u8; 4]);
         }
         b1.extend_from_slice(b"\x89PNG fake");
-        let uri = |b: &[u8]| format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(b));
+        let uri = |b: &[u8]| {
+            format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(b))
+        };
         let json = json!({
             "asset": { "version": "2.0" },
             "extensionsUsed": extensions,
@@ -205,7 +212,9 @@ mod tests {
     #[test]
     fn drops_what_nothing_references_and_keeps_the_rest_readable() {
         let mut s = scene(&[]);
-        let data = |p: super::super::Primitive| (p.attributes.into_iter().map(|(n, s)| (n, s.format, s.data)).collect::<Vec<_>>(), p.indices);
+        let data = |p: super::super::Primitive| {
+            (p.attributes.into_iter().map(|(n, s)| (n, s.format, s.data)).collect::<Vec<_>>(), p.indices)
+        };
         let before = data(s.primitive(P).unwrap());
         let image = s.image_bytes(0).unwrap();
         s.compact();

@@ -91,9 +91,10 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
     let mut bin = bin;
     let list = json.get("buffers").and_then(|b| b.as_array()).cloned().unwrap_or_default();
     for (i, b) in list.iter().enumerate() {
-        let declared = b.get("byteLength").and_then(|l| l.as_u64()).ok_or_else(|| {
-            Error::input(path, format!("buffer {i} has no byteLength"))
-        })? as usize;
+        let declared =
+            b.get("byteLength")
+                .and_then(|l| l.as_u64())
+                .ok_or_else(|| Error::input(path, format!("buffer {i} has no byteLength")))? as usize;
         let data = match b.get("uri").and_then(|u| u.as_str()) {
             Some(u) => {
                 if let uri::Target::File(p) = uri::resolve(u, &base_dir, path, opts.allow_outside)? {
@@ -101,11 +102,16 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
                 }
                 uri::read(u, &base_dir, path, opts.allow_outside)?
             }
-            None if i == 0 => bin.take().ok_or_else(|| Error::input(path, "buffer 0 has no uri and there is no GLB binary chunk"))?,
+            None if i == 0 => {
+                bin.take().ok_or_else(|| Error::input(path, "buffer 0 has no uri and there is no GLB binary chunk"))?
+            }
             None => return Err(Error::input(path, format!("buffer {i} has no uri"))),
         };
         if data.len() < declared {
-            return Err(Error::input(path, format!("buffer {i} holds {} bytes, byteLength says {declared}", data.len())));
+            return Err(Error::input(
+                path,
+                format!("buffer {i} holds {} bytes, byteLength says {declared}", data.len()),
+            ));
         }
         buffers.push(data);
     }
@@ -130,11 +136,19 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
 fn check_views(s: &Scene) -> Result<()> {
     for (i, v) in s.array("bufferViews").iter().enumerate() {
         let b = v.get("buffer").and_then(as_index).ok_or_else(|| s.err(format!("bufferView {i} has no buffer")))?;
-        let buf = s.buffers.get(b).ok_or_else(|| s.err(format!("bufferView {i} names buffer {b}, which does not exist")))?;
+        let buf =
+            s.buffers.get(b).ok_or_else(|| s.err(format!("bufferView {i} names buffer {b}, which does not exist")))?;
         let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0);
-        let len = v.get("byteLength").and_then(|o| o.as_u64()).ok_or_else(|| s.err(format!("bufferView {i} has no byteLength")))?;
+        let len = v
+            .get("byteLength")
+            .and_then(|o| o.as_u64())
+            .ok_or_else(|| s.err(format!("bufferView {i} has no byteLength")))?;
         if off.checked_add(len).map(|e| e > buf.len() as u64).unwrap_or(true) {
-            return Err(s.err(format!("bufferView {i} (bytes {off}..{}) runs past the end of buffer {b} ({} bytes)", off.saturating_add(len), buf.len())));
+            return Err(s.err(format!(
+                "bufferView {i} (bytes {off}..{}) runs past the end of buffer {b} ({} bytes)",
+                off.saturating_add(len),
+                buf.len()
+            )));
         }
     }
     Ok(())
@@ -154,13 +168,21 @@ pub fn read_accessor(s: &Scene, idx: usize) -> Result<Stream> {
     let a = s.array("accessors").get(idx).ok_or_else(|| s.err(format!("accessor {idx} does not exist")))?;
     let ct = a.get("componentType").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
     let ty = a.get("type").and_then(|t| t.as_str()).unwrap_or("");
-    let count = a.get("count").and_then(|c| c.as_u64()).ok_or_else(|| s.err(format!("accessor {idx} has no count")))? as usize;
-    let format = Format { component_type: ct, ty: ty.to_string(), normalized: a.get("normalized").and_then(|n| n.as_bool()).unwrap_or(false) };
+    let count =
+        a.get("count").and_then(|c| c.as_u64()).ok_or_else(|| s.err(format!("accessor {idx} has no count")))? as usize;
+    let format = Format {
+        component_type: ct,
+        ty: ty.to_string(),
+        normalized: a.get("normalized").and_then(|n| n.as_bool()).unwrap_or(false),
+    };
     let (Some(_), Some(_)) = (component_size(ct), component_count(ty)) else {
         return Err(s.err(format!("accessor {idx} has an unknown componentType {ct} or type '{ty}'")));
     };
     let es = format.elem_size();
-    let total = count.checked_mul(es).filter(|&t| t <= 1 << 31).ok_or_else(|| s.err(format!("accessor {idx}: count {count} is absurd")))?;
+    let total = count
+        .checked_mul(es)
+        .filter(|&t| t <= 1 << 31)
+        .ok_or_else(|| s.err(format!("accessor {idx}: count {count} is absurd")))?;
     let mut data = vec![0u8; 0];
     match a.get("bufferView").and_then(as_index) {
         Some(view) => {
@@ -174,7 +196,10 @@ pub fn read_accessor(s: &Scene, idx: usize) -> Result<Stream> {
             }
             let need = if count == 0 { 0 } else { off + stride * (count - 1) + es };
             if need > bytes.len() {
-                return Err(s.err(format!("accessor {idx} needs {need} bytes of bufferView {view}, which has {}", bytes.len())));
+                return Err(s.err(format!(
+                    "accessor {idx} needs {need} bytes of bufferView {view}, which has {}",
+                    bytes.len()
+                )));
             }
             data.reserve(total);
             for i in 0..count {

@@ -94,10 +94,13 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
     let mut bin = Bin::default();
     let mut files = Outputs::new();
     let out_dir = out.parent().map(|p| p.to_path_buf()).unwrap_or_default();
-    let dangling = |what: &str, Dangling(i, n)| scene.err(format!("{what} {i} is referenced but does not exist ({n} in the file)"));
+    let dangling = |what: &str, Dangling(i, n)| {
+        scene.err(format!("{what} {i} is referenced but does not exist ({n} in the file)"))
+    };
 
     // Accessors.
-    let dropped = drop_unreferenced(&mut json, "accessors", keep_all, accessor_refs).map_err(|d| dangling("accessor", d))?;
+    let dropped =
+        drop_unreferenced(&mut json, "accessors", keep_all, accessor_refs).map_err(|d| dangling("accessor", d))?;
     stats.accessors_dropped = dropped + scene.ledger.accessors_dropped;
 
     // Images: embedded, copied or written out, before buffer views are renumbered.
@@ -132,7 +135,11 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
                 if scene.own_images {
                     bytes = strip_png_colour_chunks(bytes);
                 }
-                let mime = img.get("mimeType").and_then(|m| m.as_str()).map(|s| s.to_string()).unwrap_or_else(|| sniff_mime(&bytes, u.as_deref().unwrap_or("")));
+                let mime = img
+                    .get("mimeType")
+                    .and_then(|m| m.as_str())
+                    .map(|s| s.to_string())
+                    .unwrap_or_else(|| sniff_mime(&bytes, u.as_deref().unwrap_or("")));
                 let o = img.as_object_mut().ok_or_else(|| scene.err(format!("image {i} is not an object")))?;
                 o.remove("uri");
                 o.remove("bufferView");
@@ -142,7 +149,13 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
                         pending_views.push((bytes, i));
                     }
                     Place::DataUri => {
-                        o.insert("uri".into(), json!(format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(&bytes))));
+                        o.insert(
+                            "uri".into(),
+                            json!(format!(
+                                "data:{mime};base64,{}",
+                                base64::engine::general_purpose::STANDARD.encode(&bytes)
+                            )),
+                        );
                     }
                     _ => {
                         let ext = mime.rsplit('/').next().unwrap_or("png").replace("jpeg", "jpg");
@@ -160,7 +173,8 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
     }
 
     // Buffer views: keep what kept accessors, images and compressed primitives use; repack.
-    let dropped = drop_unreferenced(&mut json, "bufferViews", keep_all, view_refs).map_err(|d| dangling("bufferView", d))?;
+    let dropped =
+        drop_unreferenced(&mut json, "bufferViews", keep_all, view_refs).map_err(|d| dangling("bufferView", d))?;
     stats.buffer_views_dropped = dropped + scene.ledger.views_dropped;
     for p in pack_views(&mut json, &scene.buffers).ok_or_else(|| scene.err("bufferView runs past its buffer"))? {
         bin.pad4();
@@ -187,7 +201,10 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
         let mut b = json!({ "byteLength": bin.len });
         if !glb {
             if opts.embed {
-                b["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(bin.parts.concat())));
+                b["uri"] = json!(format!(
+                    "data:application/octet-stream;base64,{}",
+                    base64::engine::general_purpose::STANDARD.encode(bin.parts.concat())
+                ));
             } else {
                 let name = format!("{}.bin", out.file_stem().and_then(|s| s.to_str()).unwrap_or("scene"));
                 b["uri"] = json!(name);

@@ -27,7 +27,8 @@ pub fn limits() -> Limits {
 }
 
 fn reader(bytes: &[u8]) -> Result<ImageReader<Cursor<&[u8]>>, String> {
-    let r = ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| format!("cannot read image: {e}"))?;
+    let r =
+        ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| format!("cannot read image: {e}"))?;
     if r.format().is_none() {
         return Err("not an image in a format bumpbake reads (PNG, TIFF, OpenEXR)".into());
     }

@@ -171,8 +171,14 @@ impl Scene {
         if let Some(u) = img.get("uri").and_then(|u| u.as_str()) {
             return uri::read(u, &self.base_dir, &self.source, self.allow_outside);
         }
-        let v = img.get("bufferView").and_then(as_index).ok_or_else(|| self.err(format!("image {i} has neither uri nor bufferView")))?;
-        let view = self.array("bufferViews").get(v).ok_or_else(|| self.err(format!("image {i}: bufferView {v} does not exist")))?;
+        let v = img
+            .get("bufferView")
+            .and_then(as_index)
+            .ok_or_else(|| self.err(format!("image {i} has neither uri nor bufferView")))?;
+        let view = self
+            .array("bufferViews")
+            .get(v)
+            .ok_or_else(|| self.err(format!("image {i}: bufferView {v} does not exist")))?;
         let b = view.get("buffer").and_then(as_index).unwrap_or(0);
         let off = view.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
         let len = view.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
@@ -185,7 +191,11 @@ impl Scene {
 
     /// Adds encoded image bytes (kept in the buffer) as a new image; returns its index.
     pub fn push_image(&mut self, bytes: &[u8], mime: &str, name: Option<&str>) -> usize {
-        let s = Stream { format: Format { component_type: accessor::UNSIGNED_BYTE, ty: "SCALAR".into(), normalized: false }, data: bytes.to_vec(), template: None };
+        let s = Stream {
+            format: Format { component_type: accessor::UNSIGNED_BYTE, ty: "SCALAR".into(), normalized: false },
+            data: bytes.to_vec(),
+            template: None,
+        };
         // Reuse the accessor path for the bytes, then keep only its buffer view.
         let acc = self.push_accessor(&s, None, false);
         let view = self.json["accessors"][acc]["bufferView"].clone();
@@ -255,7 +265,8 @@ impl Scene {
             .ok_or_else(|| self.err(format!("{where_}: no attributes")))?;
         let mut attributes = Vec::new();
         for (name, idx) in attrs {
-            let idx = as_index(idx).ok_or_else(|| self.err(format!("{where_}: attribute {name} is not an accessor index")))?;
+            let idx = as_index(idx)
+                .ok_or_else(|| self.err(format!("{where_}: attribute {name} is not an accessor index")))?;
             attributes.push((name.clone(), self.accessor(idx)?));
         }
         let mut targets = Vec::new();
@@ -263,7 +274,8 @@ impl Scene {
             for t in ts {
                 let mut streams = Vec::new();
                 for (name, idx) in t.as_object().into_iter().flatten() {
-                    let idx = as_index(idx).ok_or_else(|| self.err(format!("{where_}: morph target {name} is not an accessor index")))?;
+                    let idx = as_index(idx)
+                        .ok_or_else(|| self.err(format!("{where_}: morph target {name} is not an accessor index")))?;
                     streams.push((name.clone(), self.accessor(idx)?));
                 }
                 targets.push(streams);
@@ -287,19 +299,25 @@ impl Scene {
         }
         for (name, s) in attributes.iter().chain(targets.iter().flatten()) {
             if s.len() != count {
-                return Err(self.err(format!("{where_}: attribute {name} has {} elements, POSITION has {count}", s.len())));
+                return Err(
+                    self.err(format!("{where_}: attribute {name} has {} elements, POSITION has {count}", s.len()))
+                );
             }
         }
         let indices = match pj.get("indices") {
             Some(i) => {
                 let idx = as_index(i).ok_or_else(|| self.err(format!("{where_}: indices is not an accessor index")))?;
                 let s = self.accessor(idx)?;
-                if s.format.ty != "SCALAR" || !matches!(s.format.component_type, UNSIGNED_BYTE | UNSIGNED_SHORT | UNSIGNED_INT) {
+                if s.format.ty != "SCALAR"
+                    || !matches!(s.format.component_type, UNSIGNED_BYTE | UNSIGNED_SHORT | UNSIGNED_INT)
+                {
                     return Err(self.err(format!("{where_}: index accessor {idx} is not an unsigned integer scalar")));
                 }
                 let v = s.to_u32();
                 if let Some((k, bad)) = v.iter().enumerate().find(|(_, &x)| x as usize >= count) {
-                    return Err(self.err(format!("{where_}: index {bad} at position {k} is out of range (the primitive has {count} vertices)")));
+                    return Err(self.err(format!(
+                        "{where_}: index {bad} at position {k} is out of range (the primitive has {count} vertices)"
+                    )));
                 }
                 v
             }
@@ -343,7 +361,11 @@ impl Scene {
         }
         index_stream.template = match self.ledger.detached.remove(&r) {
             Some(template) => Some(template),
-            None => self.prim_json(r).get("indices").and_then(as_index).and_then(|i| self.array("accessors").get(i).cloned()),
+            None => self
+                .prim_json(r)
+                .get("indices")
+                .and_then(as_index)
+                .and_then(|i| self.array("accessors").get(i).cloned()),
         };
         let ii = self.push_stream(index_stream, Some(34963), false);
         let pj = self.prim_json_mut(r);
@@ -427,10 +449,18 @@ impl Scene {
 fn index_stream(indices: &[u32], vertex_count: usize) -> Stream {
     if vertex_count < 65535 {
         let data = indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect();
-        Stream { format: Format { component_type: UNSIGNED_SHORT, ty: "SCALAR".into(), normalized: false }, data, template: None }
+        Stream {
+            format: Format { component_type: UNSIGNED_SHORT, ty: "SCALAR".into(), normalized: false },
+            data,
+            template: None,
+        }
     } else {
         let data = indices.iter().flat_map(|&i| i.to_le_bytes()).collect();
-        Stream { format: Format { component_type: UNSIGNED_INT, ty: "SCALAR".into(), normalized: false }, data, template: None }
+        Stream {
+            format: Format { component_type: UNSIGNED_INT, ty: "SCALAR".into(), normalized: false },
+            data,
+            template: None,
+        }
     }
 }
 

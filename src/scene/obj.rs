@@ -15,7 +15,13 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mtl_error: RefCell<Option<Error>> = RefCell::new(None);
     let mtl_files: RefCell<Vec<std::path::PathBuf>> = RefCell::new(Vec::new());
-    let load = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true, ..Default::default() };
+    let load = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
     let (models, materials) = tobj::load_obj_buf(&mut BufReader::new(bytes), &load, |mtl: &Path| {
         let name = mtl.to_string_lossy();
         mtl_files.borrow_mut().push(base_dir.join(mtl));
@@ -84,7 +90,13 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     Ok(scene)
 }
 
-fn build_primitive(path: &Path, m: &tobj::Mesh, normals: NormalMode, notes: &mut Vec<String>, name: &str) -> Result<super::Primitive> {
+fn build_primitive(
+    path: &Path,
+    m: &tobj::Mesh,
+    normals: NormalMode,
+    notes: &mut Vec<String>,
+    name: &str,
+) -> Result<super::Primitive> {
     let np = m.positions.len() / 3;
     if let Some(i) = m.positions.iter().position(|x| !x.is_finite()) {
         return Err(Error::input(path, format!("object '{name}': vertex {} has a non-finite coordinate", i / 3 + 1)));
@@ -92,36 +104,55 @@ fn build_primitive(path: &Path, m: &tobj::Mesh, normals: NormalMode, notes: &mut
     let corners = m.indices.len();
     let check = |idx: &[u32], n: usize, what: &str| -> Result<()> {
         match idx.iter().find(|&&i| i as usize >= n) {
-            Some(bad) => Err(Error::input(path, format!("object '{name}': {what} index {} is out of range ({n} defined)", bad + 1))),
+            Some(bad) => Err(Error::input(
+                path,
+                format!("object '{name}': {what} index {} is out of range ({n} defined)", bad + 1),
+            )),
             None => Ok(()),
         }
     };
     check(&m.indices, np, "vertex")?;
-    let pos: Vec<[f32; 3]> = m.indices.iter().map(|&i| {
-        let i = i as usize * 3;
-        [m.positions[i], m.positions[i + 1], m.positions[i + 2]]
-    }).collect();
+    let pos: Vec<[f32; 3]> = m
+        .indices
+        .iter()
+        .map(|&i| {
+            let i = i as usize * 3;
+            [m.positions[i], m.positions[i + 1], m.positions[i + 2]]
+        })
+        .collect();
     let has_n = m.normal_indices.len() == corners && !m.normals.is_empty();
     let nrm: Vec<[f32; 3]> = if has_n {
         check(&m.normal_indices, m.normals.len() / 3, "normal")?;
-        m.normal_indices.iter().map(|&i| {
-            let i = i as usize * 3;
-            unit_or_up([m.normals[i], m.normals[i + 1], m.normals[i + 2]])
-        }).collect()
+        m.normal_indices
+            .iter()
+            .map(|&i| {
+                let i = i as usize * 3;
+                unit_or_up([m.normals[i], m.normals[i + 1], m.normals[i + 2]])
+            })
+            .collect()
     } else {
         let (n, fixed) = match normals {
             NormalMode::Smooth => smooth_normals(&m.positions, &m.indices),
             NormalMode::Flat => flat_normals(&pos),
         };
         if fixed > 0 {
-            notes.push(format!("object '{name}': {fixed} corners had no defined normal (degenerate faces); they point along +Z"));
+            notes.push(format!(
+                "object '{name}': {fixed} corners had no defined normal (degenerate faces); they point along +Z"
+            ));
         }
         n
     };
-    let mut attrs = vec![("POSITION".to_string(), Stream::from_f32("VEC3", &pos)), ("NORMAL".to_string(), Stream::from_f32("VEC3", &nrm))];
+    let mut attrs = vec![
+        ("POSITION".to_string(), Stream::from_f32("VEC3", &pos)),
+        ("NORMAL".to_string(), Stream::from_f32("VEC3", &nrm)),
+    ];
     if m.texcoord_indices.len() == corners && !m.texcoords.is_empty() {
         check(&m.texcoord_indices, m.texcoords.len() / 2, "texture coordinate")?;
-        let uv: Vec<[f32; 2]> = m.texcoord_indices.iter().map(|&i| [m.texcoords[i as usize * 2], m.texcoords[i as usize * 2 + 1]]).collect();
+        let uv: Vec<[f32; 2]> = m
+            .texcoord_indices
+            .iter()
+            .map(|&i| [m.texcoords[i as usize * 2], m.texcoords[i as usize * 2 + 1]])
+            .collect();
         if uv.iter().flatten().any(|x| !x.is_finite()) {
             return Err(Error::input(path, format!("object '{name}': a texture coordinate is not finite")));
         }
@@ -169,15 +200,18 @@ pub fn smooth_normals(positions: &[f32], indices: &[u32]) -> (Vec<[f32; 3]>, usi
         }
     }
     let mut fixed = 0;
-    let out = indices.iter().map(|&i| {
-        let n = pow2_scaled(acc[i as usize]).normalize_or_zero();
-        if n == glam::Vec3::ZERO || !n.is_finite() {
-            fixed += 1;
-            [0.0, 0.0, 1.0]
-        } else {
-            n.to_array()
-        }
-    }).collect();
+    let out = indices
+        .iter()
+        .map(|&i| {
+            let n = pow2_scaled(acc[i as usize]).normalize_or_zero();
+            if n == glam::Vec3::ZERO || !n.is_finite() {
+                fixed += 1;
+                [0.0, 0.0, 1.0]
+            } else {
+                n.to_array()
+            }
+        })
+        .collect();
     (out, fixed)
 }
 
@@ -261,10 +295,12 @@ fn add_texture(scene: &mut Scene, file: &str) -> usize {
 }
 
 fn encode_segment(s: &str) -> String {
-    s.bytes().map(|b| match b {
-        b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' => (b as char).to_string(),
-        _ => format!("%{b:02X}"),
-    }).collect()
+    s.bytes()
+        .map(|b| match b {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' => (b as char).to_string(),
+            _ => format!("%{b:02X}"),
+        })
+        .collect()
 }
 
 fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<()> {
@@ -297,8 +333,15 @@ fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<(
                 mat["normalTexture"]["scale"] = json!(tex.bm);
             }
         } else {
-            scene.notes.push(format!("material '{}': bump map '{}' is a height map; `bumpbake bake` converts it", m.name, tex.file));
-            scene.height_maps.push(HeightMapRef { material: index, path: scene.base_dir.join(&tex.file), multiplier: tex.bm });
+            scene.notes.push(format!(
+                "material '{}': bump map '{}' is a height map; `bumpbake bake` converts it",
+                m.name, tex.file
+            ));
+            scene.height_maps.push(HeightMapRef {
+                material: index,
+                path: scene.base_dir.join(&tex.file),
+                multiplier: tex.bm,
+            });
         }
     }
     array_mut(&mut scene.json, "materials").push(mat);
@@ -313,7 +356,9 @@ fn looks_like_normal_map(scene: &mut Scene, file: &str) -> bool {
     let bytes = match super::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) {
         Ok(b) => b,
         Err(e) => {
-            scene.notes.push(format!("bump map '{file}' could not be read to classify it ({e}); taken as a height map"));
+            scene
+                .notes
+                .push(format!("bump map '{file}' could not be read to classify it ({e}); taken as a height map"));
             return false;
         }
     };

@@ -32,7 +32,10 @@ pub fn resolve(uri: &str, base_dir: &Path, source: &Path, allow_outside: bool) -
         return Ok(Target::Data { mime: mime.to_string(), bytes });
     }
     if uri.contains("://") {
-        return Err(Error::input(source, format!("URI '{}' is not a local file; only relative paths and data URIs are read", short(uri))));
+        return Err(Error::input(
+            source,
+            format!("URI '{}' is not a local file; only relative paths and data URIs are read", short(uri)),
+        ));
     }
     let decoded = percent_decode(uri);
     let rel = Path::new(&decoded);
@@ -49,8 +52,9 @@ pub fn resolve(uri: &str, base_dir: &Path, source: &Path, allow_outside: bool) -
 pub fn read(uri: &str, base_dir: &Path, source: &Path, allow_outside: bool) -> Result<Vec<u8>> {
     match resolve(uri, base_dir, source, allow_outside)? {
         Target::Data { bytes, .. } => Ok(bytes),
-        Target::File(p) => std::fs::read(&p)
-            .map_err(|e| Error::input(source, format!("cannot read '{}' ({}): {e}", uri, p.display()))),
+        Target::File(p) => {
+            std::fs::read(&p).map_err(|e| Error::input(source, format!("cannot read '{}' ({}): {e}", uri, p.display())))
+        }
     }
 }
 

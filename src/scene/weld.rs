@@ -46,7 +46,8 @@ pub fn weld(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)
             keys.extend_from_slice(s.elem(c));
         }
     }
-    let mut first: HashMap<&[u8], u32, BuildHasherDefault<Fx>> = HashMap::with_capacity_and_hasher(corners, Default::default());
+    let mut first: HashMap<&[u8], u32, BuildHasherDefault<Fx>> =
+        HashMap::with_capacity_and_hasher(corners, Default::default());
     let mut order: Vec<u32> = Vec::new();
     let mut indices = Vec::with_capacity(corners);
     for c in 0..corners {
@@ -58,12 +59,7 @@ pub fn weld(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)
         indices.push(v);
     }
     let gather = |list: Vec<(String, Stream)>| list.into_iter().map(|(n, s)| (n, s.gather(&order))).collect::<Vec<_>>();
-    Primitive {
-        attributes: gather(attributes),
-        targets: targets.into_iter().map(gather).collect(),
-        indices,
-        mode,
-    }
+    Primitive { attributes: gather(attributes), targets: targets.into_iter().map(gather).collect(), indices, mode }
 }
 
 /// For each item, the first item (lowest index) equal to it. `hashes[i]` is item `i`'s hash, or 0
@@ -187,8 +183,10 @@ impl SplitPlan {
     pub fn new(base: &Primitive, leave_out: &[&str], extra: &[CornerStream]) -> SplitPlan {
         use rayon::prelude::*;
         let corners = base.indices.len();
-        let kept: Vec<&(String, Stream)> = base.attributes.iter().filter(|(n, _)| !leave_out.contains(&n.as_str())).collect();
-        let vertex_streams: Vec<&Stream> = kept.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
+        let kept: Vec<&(String, Stream)> =
+            base.attributes.iter().filter(|(n, _)| !leave_out.contains(&n.as_str())).collect();
+        let vertex_streams: Vec<&Stream> =
+            kept.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
         let n_vertices = base.vertex_count().max(base.indices.iter().map(|&v| v as usize + 1).max().unwrap_or(0));
         let mut used = vec![false; n_vertices];
         for &v in &base.indices {
@@ -260,7 +258,9 @@ impl SplitPlan {
         let extra = extra
             .iter()
             .zip(data)
-            .map(|(s, data)| (s.at, s.name.to_string(), Stream { format: super::accessor::Format::f32(s.ty), data, template: None }))
+            .map(|(s, data)| {
+                (s.at, s.name.to_string(), Stream { format: super::accessor::Format::f32(s.ty), data, template: None })
+            })
             .collect();
         SplitPlan { indices, origins, leave_out: leave_out.iter().map(|s| s.to_string()).collect(), extra }
     }
@@ -275,7 +275,8 @@ impl SplitPlan {
         let Primitive { attributes, targets, indices, mode } = base;
         drop(indices);
         let origins = &self.origins;
-        let gather = |list: Vec<(String, Stream)>| list.into_iter().map(|(n, s)| (n, s.gather(origins))).collect::<Vec<_>>();
+        let gather =
+            |list: Vec<(String, Stream)>| list.into_iter().map(|(n, s)| (n, s.gather(origins))).collect::<Vec<_>>();
         let mut attributes = gather(attributes.into_iter().filter(|(n, _)| !self.leave_out.contains(n)).collect());
         for (at, name, stream) in self.extra {
             if at < attributes.len() {
@@ -290,7 +291,8 @@ impl SplitPlan {
 
 /// Expands an indexed primitive to one element per corner (the inverse of [`weld`]).
 pub fn unweld(p: &Primitive) -> (Vec<(String, Stream)>, Vec<Vec<(String, Stream)>>) {
-    let per_corner = |list: &Vec<(String, Stream)>| list.iter().map(|(n, s)| (n.clone(), s.gather(&p.indices))).collect::<Vec<_>>();
+    let per_corner =
+        |list: &Vec<(String, Stream)>| list.iter().map(|(n, s)| (n.clone(), s.gather(&p.indices))).collect::<Vec<_>>();
     (per_corner(&p.attributes), p.targets.iter().map(per_corner).collect())
 }
 
@@ -314,9 +316,23 @@ mod tests {
     fn split_corners_splits_by_the_new_streams_and_merges_equal_vertices() {
         // Vertices 1 and 2 are byte-identical; vertex 0's last corner gets another tangent.
         let uv = Stream::from_f32("VEC2", &[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0]]);
-        let p = Primitive { attributes: vec![("TEXCOORD_0".into(), uv)], targets: vec![], indices: vec![0, 1, 2, 0], mode: 4 };
+        let p = Primitive {
+            attributes: vec![("TEXCOORD_0".into(), uv)],
+            targets: vec![],
+            indices: vec![0, 1, 2, 0],
+            mode: 4,
+        };
         let t = [[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, -1.0f32]];
-        let out = split_corners(&p, &[], &[CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: CornerValues::Flat(t.as_flattened()) }]);
+        let out = split_corners(
+            &p,
+            &[],
+            &[CornerStream {
+                at: usize::MAX,
+                name: "TANGENT",
+                ty: "VEC4",
+                values: CornerValues::Flat(t.as_flattened()),
+            }],
+        );
         assert_eq!(out.indices, vec![0, 1, 1, 2]);
         assert_eq!(out.attr("TANGENT").unwrap().to_f32::<4>()[2], [-1.0, 0.0, 0.0, -1.0]);
         assert_eq!(out.attributes.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["TEXCOORD_0", "TANGENT"]);

@@ -62,7 +62,14 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
     let mut reports = Vec::new();
     let mut work: Vec<(PrimRef, u32, Primitive, Option<String>)> = Vec::new();
     for r in scene.primitives() {
-        let report = |action, reason: Option<String>, uv_set| PrimReport { mesh: r.mesh, primitive: r.primitive, action, reason, uv_set, stats: None };
+        let report = |action, reason: Option<String>, uv_set| PrimReport {
+            mesh: r.mesh,
+            primitive: r.primitive,
+            action,
+            reason,
+            uv_set,
+            stats: None,
+        };
         match needs_tangents(scene, r, opts.all) {
             Err(why) => reports.push(report("skipped", Some(why), None)),
             Ok(set) => {
@@ -70,7 +77,11 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
                 let why = match p.attr("TANGENT") {
                     Some(t) if !opts.overwrite => match invalid_tangents(t) {
                         0 => {
-                            reports.push(report("kept", Some("valid tangents already present (--overwrite replaces them)".into()), Some(set)));
+                            reports.push(report(
+                                "kept",
+                                Some("valid tangents already present (--overwrite replaces them)".into()),
+                                Some(set),
+                            ));
                             continue;
                         }
                         n => Some(format!("replaced {n} invalid existing tangents (NaN, non-unit, zero or w not +-1)")),
@@ -87,10 +98,8 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
     let refs: Vec<PrimRef> = work.iter().map(|w| w.0).collect();
     scene.release_primitives(&refs);
     let v_up = scene.uv_v_up;
-    let done: Vec<(Primitive, FrameStats)> = work
-        .into_par_iter()
-        .map(|(_, set, p, _)| primitive_with_stats(p, set, v_up, &opts.frames))
-        .collect();
+    let done: Vec<(Primitive, FrameStats)> =
+        work.into_par_iter().map(|(_, set, p, _)| primitive_with_stats(p, set, v_up, &opts.frames)).collect();
     for (r, (p, stats)) in refs.iter().zip(done) {
         scene.put_primitive(*r, p);
         if let Some(rep) = reports.iter_mut().find(|x| x.mesh == r.mesh && x.primitive == r.primitive) {
@@ -109,7 +118,9 @@ pub fn invalid_tangents(t: &crate::scene::Stream) -> usize {
         .iter()
         .filter(|v| {
             let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            !(len.is_finite() && (len - 1.0).abs() <= super::fallback::UNIT_TOLERANCE * 5.0 && (v[3] == 1.0 || v[3] == -1.0))
+            !(len.is_finite()
+                && (len - 1.0).abs() <= super::fallback::UNIT_TOLERANCE * 5.0
+                && (v[3] == 1.0 || v[3] == -1.0))
         })
         .count()
 }
@@ -118,7 +129,9 @@ pub fn invalid_tangents(t: &crate::scene::Stream) -> usize {
 pub fn to_triangle_list(mut p: Primitive) -> Primitive {
     let i = &p.indices;
     let list: Vec<u32> = match p.mode {
-        5 => (2..i.len()).flat_map(|k| if k % 2 == 0 { [i[k - 2], i[k - 1], i[k]] } else { [i[k - 1], i[k - 2], i[k]] }).collect(),
+        5 => (2..i.len())
+            .flat_map(|k| if k % 2 == 0 { [i[k - 2], i[k - 1], i[k]] } else { [i[k - 1], i[k - 2], i[k]] })
+            .collect(),
         6 => (2..i.len()).flat_map(|k| [i[0], i[k - 1], i[k]]).collect(),
         _ => {
             let n = i.len() / 3 * 3;

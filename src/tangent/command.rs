@@ -51,7 +51,14 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     Ok(summarise(&job.input, &job.output, prims, scene.notes, written, t))
 }
 
-fn summarise(input: &Path, output: &Path, prims: Vec<PrimReport>, notes: Vec<String>, written: WriteStats, t: Timings) -> TangentsReport {
+fn summarise(
+    input: &Path,
+    output: &Path,
+    prims: Vec<PrimReport>,
+    notes: Vec<String>,
+    written: WriteStats,
+    t: Timings,
+) -> TangentsReport {
     let count = |a: &str| prims.iter().filter(|p| p.action == a).count();
     let stats = prims.iter().filter_map(|p| p.stats.as_ref());
     TangentsReport {
@@ -85,9 +92,20 @@ impl TangentsReport {
             let at = format!("  mesh {} primitive {}", p.mesh, p.primitive);
             match (&p.stats, &p.reason) {
                 (Some(st), _) => {
-                    s += &format!("{at}: TEXCOORD_{} {} tris, vertices {} -> {}", p.uv_set.unwrap_or(0), st.triangles, st.vertices_in, st.vertices_out);
+                    s += &format!(
+                        "{at}: TEXCOORD_{} {} tris, vertices {} -> {}",
+                        p.uv_set.unwrap_or(0),
+                        st.triangles,
+                        st.vertices_in,
+                        st.vertices_out
+                    );
                     if st.fallback.total() > 0 {
-                        s += &format!(", {} fallback frames ({} undefined, {} invalid)", st.fallback.total(), st.fallback.undefined, st.fallback.invalid);
+                        s += &format!(
+                            ", {} fallback frames ({} undefined, {} invalid)",
+                            st.fallback.total(),
+                            st.fallback.undefined,
+                            st.fallback.invalid
+                        );
                     }
                     if st.generated_normals {
                         s += ", flat normals generated (NORMAL was missing)";
@@ -107,7 +125,10 @@ impl TangentsReport {
         if self.written.accessors_dropped > 0 {
             s += &format!(
                 "  dropped {} unreferenced accessors, {} buffer views ({} -> {} buffer bytes)\n",
-                self.written.accessors_dropped, self.written.buffer_views_dropped, self.written.buffer_bytes_in, self.written.buffer_bytes_out
+                self.written.accessors_dropped,
+                self.written.buffer_views_dropped,
+                self.written.buffer_bytes_in,
+                self.written.buffer_bytes_out
             );
         }
         let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();

@@ -73,7 +73,10 @@ pub fn is_valid(t: [f32; 4], n: Vec3) -> bool {
 fn is_valid_unit(t: [f32; 4], n: Option<Vec3>) -> bool {
     let v = Vec3::new(t[0], t[1], t[2]);
     let Some(n) = n else { return false };
-    v.is_finite() && (v.length() - 1.0).abs() <= UNIT_TOLERANCE && (t[3] == 1.0 || t[3] == -1.0) && v.dot(n).abs() <= ORTHO_TOLERANCE
+    v.is_finite()
+        && (v.length() - 1.0).abs() <= UNIT_TOLERANCE
+        && (t[3] == 1.0 || t[3] == -1.0)
+        && v.dot(n).abs() <= ORTHO_TOLERANCE
 }
 
 /// The unit vector orthogonal to `n` nearest to `t`, if `t` is far enough from parallel
@@ -118,7 +121,8 @@ pub fn repair(frames: &mut Frames, at: CornerNormals) -> FallbackCounts {
     let mut counts = FallbackCounts::default();
     // Unit normals, once per normal rather than once per corner.
     let units: Vec<Option<Vec3>> = at.normals.par_iter().with_min_len(1 << 12).map(|&n| unit(Vec3::from(n))).collect();
-    let ok = |c: usize| frames.get(c, at.normal_of[c]).is_some_and(|t| is_valid_unit(t, units[at.normal_of[c] as usize]));
+    let ok =
+        |c: usize| frames.get(c, at.normal_of[c]).is_some_and(|t| is_valid_unit(t, units[at.normal_of[c] as usize]));
     let bad: Vec<usize> = (0..at.normal_of.len()).into_par_iter().with_min_len(1 << 12).filter(|&c| !ok(c)).collect();
     if bad.is_empty() {
         return counts;
@@ -144,8 +148,12 @@ pub fn repair(frames: &mut Frames, at: CornerNormals) -> FallbackCounts {
         }
         let n = Vec3::from(at.normals[at.normal_of[c] as usize]);
         let tri = c / 3 * 3;
-        let lenders = (tri..tri + 3).filter(|&k| k != c && !bad_flag[k]).chain(Some(by_vertex[at.vertex[c] as usize]).filter(|&k| k != usize::MAX));
-        let chosen = lenders.filter_map(|k| frames.get(k, at.normal_of[k])).find_map(|t| orthogonalise(Vec3::new(t[0], t[1], t[2]), n).map(|v| [v.x, v.y, v.z, t[3]]));
+        let lenders = (tri..tri + 3)
+            .filter(|&k| k != c && !bad_flag[k])
+            .chain(Some(by_vertex[at.vertex[c] as usize]).filter(|&k| k != usize::MAX));
+        let chosen = lenders
+            .filter_map(|k| frames.get(k, at.normal_of[k]))
+            .find_map(|t| orthogonalise(Vec3::new(t[0], t[1], t[2]), n).map(|v| [v.x, v.y, v.z, t[3]]));
         repaired.push(match chosen {
             Some(f) => {
                 counts.borrowed += 1;

@@ -79,7 +79,12 @@ pub(crate) struct Builder<'a> {
 impl<'a> Builder<'a> {
     pub(crate) fn new(idx: &'a [u32]) -> Builder<'a> {
         let n_vertices = idx.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
-        Builder { idx, vertex: vec![UNSET; n_vertices], corner: Overrides::default(), given: vec![0; idx.len().div_ceil(64)] }
+        Builder {
+            idx,
+            vertex: vec![UNSET; n_vertices],
+            corner: Overrides::default(),
+            given: vec![0; idx.len().div_ceil(64)],
+        }
     }
 
     /// Corner `c` gets value `slot`. Each corner at most once.
@@ -127,7 +132,14 @@ mod tests {
     fn corners_share_their_vertex_value_unless_they_differ() {
         // Vertex 0 has three corners: two share a frame, one has another, one has none.
         let idx = [0, 1, 0, 0, 2, 3];
-        let flat = vec![[1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [0.0; 4], [0.0; 4], [0.0, 0.0, 1.0, -1.0]];
+        let flat = vec![
+            [1.0, 0.0, 0.0, 1.0],
+            [0.0, 1.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0, 1.0],
+            [0.0; 4],
+            [0.0; 4],
+            [0.0, 0.0, 1.0, -1.0],
+        ];
         let mut b = Builder::new(&idx);
         let values = vec![flat[0], flat[1], flat[5]];
         b.put(0, 0);

@@ -30,7 +30,9 @@ pub fn frames(mesh: &TriMesh, engine: Engine) -> Vec<[f32; 4]> {
 /// [`generate`] as [`Frames`]: each value once per group of corners the engine shares it among
 /// (the fast engine), or once per corner (the reference), found through `mesh.indices`.
 pub fn compact(mesh: &TriMesh, engine: Engine) -> Frames {
-    let bevy = |mesh: &TriMesh| Frames::from_flat(mesh.indices, generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect());
+    let bevy = |mesh: &TriMesh| {
+        Frames::from_flat(mesh.indices, generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect())
+    };
     match engine {
         Engine::Bevy => bevy(mesh),
         Engine::Fast => match super::fast::generate(mesh) {

@@ -86,11 +86,17 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
         flat = flat_normals(&cp).0;
         cu = p.indices.iter().map(|&i| uvs[i as usize]).collect();
         corner_ids = (0..p.indices.len() as u32).collect();
-        let frames = generate_with_stack(&TriMesh { positions: &cp, normals: &flat, uvs: &cu, indices: &corner_ids }, opts.engine);
+        let frames = generate_with_stack(
+            &TriMesh { positions: &cp, normals: &flat, uvs: &cu, indices: &corner_ids },
+            opts.engine,
+        );
         (flat.as_slice().into(), corner_ids.as_slice(), frames)
     } else {
         let n = p.attr("NORMAL").map(|s| s.as_f32()).unwrap_or_default();
-        let frames = generate_with_stack(&TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices }, opts.engine);
+        let frames = generate_with_stack(
+            &TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices },
+            opts.engine,
+        );
         (n, p.indices.as_slice(), frames)
     };
     drop((positions, uvs));
@@ -99,7 +105,8 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
         // glTF UVs run v down: the output's w is the reference's sign negated (see the conventions).
         frames.values.iter_mut().for_each(|t| t[3] = -t[3]);
     }
-    let fallback = fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
+    let fallback =
+        fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
     crate::report::mem_mark("repair");
 
     // Every corner has a frame now. Tangents and bitangents are read through the compact frames,
@@ -107,16 +114,27 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
     let tangent = |c: usize| frames.get(c, normal_of[c]).unwrap_or([0.0; 4]);
     let bitangent = |c: usize| {
         let t = tangent(c);
-        let b = Vec3::from(normals[normal_of[c] as usize]).normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3];
+        let b =
+            Vec3::from(normals[normal_of[c] as usize]).normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3];
         [b.x, b.y, b.z, 0.0]
     };
     let mut extra = Vec::new();
     if generated_normals {
-        extra.push(CornerStream { at: 1, name: "NORMAL", ty: "VEC3", values: CornerValues::Flat(normals.as_flattened()) });
+        extra.push(CornerStream {
+            at: 1,
+            name: "NORMAL",
+            ty: "VEC3",
+            values: CornerValues::Flat(normals.as_flattened()),
+        });
     }
     extra.push(CornerStream { at: usize::MAX, name: "TANGENT", ty: "VEC4", values: CornerValues::Fn(&tangent) });
     if opts.bitangents {
-        extra.push(CornerStream { at: usize::MAX, name: "_BITANGENT", ty: "VEC3", values: CornerValues::Fn(&bitangent) });
+        extra.push(CornerStream {
+            at: usize::MAX,
+            name: "_BITANGENT",
+            ty: "VEC3",
+            values: CornerValues::Fn(&bitangent),
+        });
     }
     (SplitPlan::new(p, &["TANGENT", "_BITANGENT"], &extra), fallback)
 }
@@ -146,7 +164,11 @@ fn generate_with_stack(mesh: &TriMesh, engine: mikk::Engine) -> frames::Frames {
     }
     let stack = (4 << 20) + most * STACK_PER_TRIANGLE;
     std::thread::scope(|s| {
-        match std::thread::Builder::new().name("mikktspace".into()).stack_size(stack).spawn_scoped(s, || mikk::compact(mesh, engine)) {
+        match std::thread::Builder::new()
+            .name("mikktspace".into())
+            .stack_size(stack)
+            .spawn_scoped(s, || mikk::compact(mesh, engine))
+        {
             Ok(h) => h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)),
             // No thread to be had: try on this one.
             Err(_) => mikk::compact(mesh, engine),

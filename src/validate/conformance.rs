@@ -20,11 +20,13 @@ pub fn check(d: &PrimData, max_angle_deg: f64, ex: &mut Explained, s: &mut Subje
     // The engine trusts its input; give it finite values so no input can upset it.
     let clean3 = |v: &[f32; 3]| if v.iter().all(|x| x.is_finite()) { *v } else { [0.0; 3] };
     let normals_c: Vec<[f32; 3]> = normals.iter().map(clean3).collect();
-    let uvs_c: Vec<[f32; 2]> = uvs.iter().map(|v| if v.iter().all(|x| x.is_finite()) { *v } else { [0.0; 2] }).collect();
+    let uvs_c: Vec<[f32; 2]> =
+        uvs.iter().map(|v| if v.iter().all(|x| x.is_finite()) { *v } else { [0.0; 2] }).collect();
     let mesh = TriMesh { positions: &d.positions, normals: &normals_c, uvs: &uvs_c, indices: &d.indices };
     // The fast engine: bit-identical to the reference (held to it by the differential tests),
     // linear in time and without the reference's recursion, which a high-valence vertex overflows.
-    let reference = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| mikk::generate(&mesh, Engine::Fast))) {
+    let reference = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| mikk::generate(&mesh, Engine::Fast)))
+    {
         Ok(r) => r,
         Err(_) => return,
     };
@@ -82,11 +84,20 @@ pub fn check(d: &PrimData, max_angle_deg: f64, ex: &mut Explained, s: &mut Subje
     let compared = angles.len();
     let max = angles.iter().cloned().fold(0.0f64, f64::max);
     let p99 = percentile(&mut angles, 0.99);
-    s.check(Code::TANGENT_MIKK_SIGN, (sign_bad > 0).then(|| {
-        let total = compared + sign_bad;
-        Finding::new(Code::TANGENT_MIKK_SIGN, sign_bad, total, "corners", format!("{sign_bad} of {total} corners have w opposite to MikkTSpace's"))
+    s.check(
+        Code::TANGENT_MIKK_SIGN,
+        (sign_bad > 0).then(|| {
+            let total = compared + sign_bad;
+            Finding::new(
+                Code::TANGENT_MIKK_SIGN,
+                sign_bad,
+                total,
+                "corners",
+                format!("{sign_bad} of {total} corners have w opposite to MikkTSpace's"),
+            )
             .examples(w_sign.into_examples())
-    }));
+        }),
+    );
     s.check(Code::TANGENT_MIKK_ANGLE, (above > 0).then(|| {
         Finding::new(
             Code::TANGENT_MIKK_ANGLE,

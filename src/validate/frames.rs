@@ -41,7 +41,11 @@ pub struct Explained {
 
 impl Explained {
     pub fn new(vertices: usize, corners: usize) -> Self {
-        Explained { bad_vertex: vec![false; vertices], corner: vec![false; corners], degenerate_tri: vec![false; corners / 3] }
+        Explained {
+            bad_vertex: vec![false; vertices],
+            corner: vec![false; corners],
+            degenerate_tri: vec![false; corners / 3],
+        }
     }
     /// True when a corner is left for the checks that come after.
     pub fn open(&self, c: usize, v: usize) -> bool {
@@ -62,7 +66,8 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
     let Some(t) = &d.tangents else { return };
     let n = t.len();
     let (mut nonfinite, mut nonunit, mut badw, mut parallel, mut skew) = (0, 0, 0, 0, 0);
-    let (mut w_nf, mut w_nu, mut w_w, mut w_par, mut w_skew) = (Worst::default(), Worst::default(), Worst::default(), Worst::default(), Worst::default());
+    let (mut w_nf, mut w_nu, mut w_w, mut w_par, mut w_skew) =
+        (Worst::default(), Worst::default(), Worst::default(), Worst::default(), Worst::default());
     let mut worst_skew_deg = 0.0f64;
     for (v, &tv) in t.iter().enumerate() {
         let ex_v = |detail: String| Example { kind: "vertex", index: v as u64, at: None, detail };
@@ -93,30 +98,77 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
         if cos > PARALLEL_COS {
             parallel += 1;
             ex.bad_vertex[v] = true;
-            w_par.push(cos, || ex_v(format!("tangent {} vs normal {:?}: {:.2}° apart", fmt_t(tv), normals[v], cos.min(1.0).acos().to_degrees())));
+            w_par.push(cos, || {
+                ex_v(format!(
+                    "tangent {} vs normal {:?}: {:.2}° apart",
+                    fmt_t(tv),
+                    normals[v],
+                    cos.min(1.0).acos().to_degrees()
+                ))
+            });
         } else if cos > ORTHO_COS {
             skew += 1;
             ex.bad_vertex[v] = true;
             let off = cos.min(1.0).asin().to_degrees();
             worst_skew_deg = worst_skew_deg.max(off);
-            w_skew.push(cos, || ex_v(format!("tangent {} is {off:.2}° off the plane of normal {:?}", fmt_t(tv), normals[v])));
+            w_skew.push(cos, || {
+                ex_v(format!("tangent {} is {off:.2}° off the plane of normal {:?}", fmt_t(tv), normals[v]))
+            });
         }
     }
-    s.check(Code::TANGENT_NOT_FINITE, (nonfinite > 0).then(|| {
-        Finding::new(Code::TANGENT_NOT_FINITE, nonfinite, n, "vertices", format!("{nonfinite} of {n} tangents contain NaN or infinity")).examples(w_nf.into_examples())
-    }));
-    s.check(Code::TANGENT_NOT_UNIT, (nonunit > 0).then(|| {
-        Finding::new(Code::TANGENT_NOT_UNIT, nonunit, n, "vertices", format!("{nonunit} of {n} tangents are not unit length (|len - 1| > {KHRONOS_UNIT_TOLERANCE})"))
+    s.check(
+        Code::TANGENT_NOT_FINITE,
+        (nonfinite > 0).then(|| {
+            Finding::new(
+                Code::TANGENT_NOT_FINITE,
+                nonfinite,
+                n,
+                "vertices",
+                format!("{nonfinite} of {n} tangents contain NaN or infinity"),
+            )
+            .examples(w_nf.into_examples())
+        }),
+    );
+    s.check(
+        Code::TANGENT_NOT_UNIT,
+        (nonunit > 0).then(|| {
+            Finding::new(
+                Code::TANGENT_NOT_UNIT,
+                nonunit,
+                n,
+                "vertices",
+                format!("{nonunit} of {n} tangents are not unit length (|len - 1| > {KHRONOS_UNIT_TOLERANCE})"),
+            )
             .examples(w_nu.into_examples())
-    }));
-    s.check(Code::TANGENT_W_INVALID, (badw > 0).then(|| {
-        Finding::new(Code::TANGENT_W_INVALID, badw, n, "vertices", format!("{badw} of {n} tangents have w other than +1.0 or -1.0")).examples(w_w.into_examples())
-    }));
+        }),
+    );
+    s.check(
+        Code::TANGENT_W_INVALID,
+        (badw > 0).then(|| {
+            Finding::new(
+                Code::TANGENT_W_INVALID,
+                badw,
+                n,
+                "vertices",
+                format!("{badw} of {n} tangents have w other than +1.0 or -1.0"),
+            )
+            .examples(w_w.into_examples())
+        }),
+    );
     if d.normals.is_some() {
-        s.check(Code::TANGENT_PARALLEL_NORMAL, (parallel > 0).then(|| {
-            Finding::new(Code::TANGENT_PARALLEL_NORMAL, parallel, n, "vertices", format!("{parallel} of {n} tangents are (nearly) parallel to their normal: the frame collapses"))
+        s.check(
+            Code::TANGENT_PARALLEL_NORMAL,
+            (parallel > 0).then(|| {
+                Finding::new(
+                    Code::TANGENT_PARALLEL_NORMAL,
+                    parallel,
+                    n,
+                    "vertices",
+                    format!("{parallel} of {n} tangents are (nearly) parallel to their normal: the frame collapses"),
+                )
                 .examples(w_par.into_examples())
-        }));
+            }),
+        );
         s.check(Code::TANGENT_NOT_ORTHOGONAL, (skew > 0).then(|| {
             Finding::new(Code::TANGENT_NOT_ORTHOGONAL, skew, n, "vertices", format!("{skew} of {n} tangents are more than 1° off the plane orthogonal to their normal (worst {worst_skew_deg:.2}°)"))
                 .examples(w_skew.into_examples())
@@ -148,10 +200,19 @@ pub fn check_w_mixed(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
             });
         }
     }
-    s.check(Code::TANGENT_W_MIXED, (count > 0).then(|| {
-        Finding::new(Code::TANGENT_W_MIXED, count, tris, "triangles", format!("{count} of {tris} triangles have corners with different w: the bitangent flips inside them"))
+    s.check(
+        Code::TANGENT_W_MIXED,
+        (count > 0).then(|| {
+            Finding::new(
+                Code::TANGENT_W_MIXED,
+                count,
+                tris,
+                "triangles",
+                format!("{count} of {tris} triangles have corners with different w: the bitangent flips inside them"),
+            )
             .examples(worst.into_examples())
-    }));
+        }),
+    );
 }
 
 /// Zero-area, zero-UV-area (when `with_uvs`: the UVs belong to a normal texture) and sliver
@@ -177,30 +238,66 @@ pub fn check_degenerate(d: &PrimData, with_uvs: bool, ex: &mut Explained, s: &mu
         let quality = 2.0 * 3f64.sqrt() * area2 / sum_sq;
         if quality < 1e-3 {
             sliver += 1;
-            ws.push(1.0 / quality, || tri_ex(format!("vertices {} {} {}, quality {quality:.2e} (1 = equilateral)", tri[0], tri[1], tri[2])));
+            ws.push(1.0 / quality, || {
+                tri_ex(format!("vertices {} {} {}, quality {quality:.2e} (1 = equilateral)", tri[0], tri[1], tri[2]))
+            });
         }
         if let Some(uv) = uvs {
             let t = [uv[tri[0] as usize], uv[tri[1] as usize], uv[tri[2] as usize]];
-            let (a, b) = ([(t[1][0] - t[0][0]) as f64, (t[1][1] - t[0][1]) as f64], [(t[2][0] - t[0][0]) as f64, (t[2][1] - t[0][1]) as f64]);
+            let (a, b) = (
+                [(t[1][0] - t[0][0]) as f64, (t[1][1] - t[0][1]) as f64],
+                [(t[2][0] - t[0][0]) as f64, (t[2][1] - t[0][1]) as f64],
+            );
             let cross = (a[0] * b[1] - a[1] * b[0]).abs();
             let scale = a[0] * a[0] + a[1] * a[1] + b[0] * b[0] + b[1] * b[1];
             if !cross.is_finite() || scale == 0.0 || cross <= 1e-12 * scale {
                 zero_uv += 1;
                 ex.degenerate_tri[k] = true;
-                wu.push(1.0 / (1.0 + k as f64), || tri_ex(format!("vertices {} {} {}, UVs {:?} {:?} {:?}", tri[0], tri[1], tri[2], t[0], t[1], t[2])));
+                wu.push(1.0 / (1.0 + k as f64), || {
+                    tri_ex(format!("vertices {} {} {}, UVs {:?} {:?} {:?}", tri[0], tri[1], tri[2], t[0], t[1], t[2]))
+                });
             }
         }
     }
-    s.check(Code::TRIANGLE_DEGENERATE, (zero > 0).then(|| {
-        Finding::new(Code::TRIANGLE_DEGENERATE, zero, tris, "triangles", format!("{zero} of {tris} triangles have zero area")).examples(wz.into_examples())
-    }));
+    s.check(
+        Code::TRIANGLE_DEGENERATE,
+        (zero > 0).then(|| {
+            Finding::new(
+                Code::TRIANGLE_DEGENERATE,
+                zero,
+                tris,
+                "triangles",
+                format!("{zero} of {tris} triangles have zero area"),
+            )
+            .examples(wz.into_examples())
+        }),
+    );
     if uvs.is_some() {
-        s.check(Code::TRIANGLE_UV_DEGENERATE, (zero_uv > 0).then(|| {
-            Finding::new(Code::TRIANGLE_UV_DEGENERATE, zero_uv, tris, "triangles", format!("{zero_uv} of {tris} triangles have zero area in the normal map's UV space"))
+        s.check(
+            Code::TRIANGLE_UV_DEGENERATE,
+            (zero_uv > 0).then(|| {
+                Finding::new(
+                    Code::TRIANGLE_UV_DEGENERATE,
+                    zero_uv,
+                    tris,
+                    "triangles",
+                    format!("{zero_uv} of {tris} triangles have zero area in the normal map's UV space"),
+                )
                 .examples(wu.into_examples())
-        }));
+            }),
+        );
     }
-    s.check(Code::TRIANGLE_SLIVER, (sliver > 0).then(|| {
-        Finding::new(Code::TRIANGLE_SLIVER, sliver, tris, "triangles", format!("{sliver} of {tris} triangles are slivers (quality below 1e-3)")).examples(ws.into_examples())
-    }));
+    s.check(
+        Code::TRIANGLE_SLIVER,
+        (sliver > 0).then(|| {
+            Finding::new(
+                Code::TRIANGLE_SLIVER,
+                sliver,
+                tris,
+                "triangles",
+                format!("{sliver} of {tris} triangles are slivers (quality below 1e-3)"),
+            )
+            .examples(ws.into_examples())
+        }),
+    );
 }

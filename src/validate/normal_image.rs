@@ -110,7 +110,9 @@ pub fn detect(t: &Texels) -> Detection {
     if w >= 3 && h >= 3 {
         for y in 1..h - 1 {
             for x in 1..w - 1 {
-                let (Some(l), Some(r), Some(up), Some(down)) = (t.slope(x - 1, y), t.slope(x + 1, y), t.slope(x, y - 1), t.slope(x, y + 1)) else {
+                let (Some(l), Some(r), Some(up), Some(down)) =
+                    (t.slope(x - 1, y), t.slope(x + 1, y), t.slope(x, y - 1), t.slope(x, y + 1))
+                else {
                     continue;
                 };
                 // Row index decreases upwards: y - 1 is up.
@@ -123,12 +125,13 @@ pub fn detect(t: &Texels) -> Detection {
         }
     }
     let total = e_as + e_flip;
-    let (convention, confidence) = if samples == 0 || total.is_nan() || total <= 1e-12 * samples as f64 || !total.is_finite() {
-        (Convention::Unknown, 0.0)
-    } else {
-        let conf = (e_flip - e_as).abs() / total;
-        (if e_as <= e_flip { Convention::OpenGl } else { Convention::DirectX }, conf)
-    };
+    let (convention, confidence) =
+        if samples == 0 || total.is_nan() || total <= 1e-12 * samples as f64 || !total.is_finite() {
+            (Convention::Unknown, 0.0)
+        } else {
+            let conf = (e_flip - e_as).abs() / total;
+            (if e_as <= e_flip { Convention::OpenGl } else { Convention::DirectX }, conf)
+        };
     let per = |e: f64| if samples > 0 { e / samples as f64 } else { 0.0 };
     Detection { convention, confidence, curl_as_is: per(e_as), curl_flipped: per(e_flip), samples }
 }
@@ -138,7 +141,10 @@ pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut 
     let rgb8;
     let rgbf;
     let texels = match img {
-        DynamicImage::ImageLuma8(_) | DynamicImage::ImageLumaA8(_) | DynamicImage::ImageRgb8(_) | DynamicImage::ImageRgba8(_) => {
+        DynamicImage::ImageLuma8(_)
+        | DynamicImage::ImageLumaA8(_)
+        | DynamicImage::ImageRgb8(_)
+        | DynamicImage::ImageRgba8(_) => {
             rgb8 = img.to_rgb8();
             Texels::Rgb8(&rgb8)
         }
@@ -154,7 +160,12 @@ pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut 
     for y in 0..h {
         for x in 0..w {
             let n = texels.normal(x, y);
-            let texel = |detail: String| Example { kind: "texel", index: y as u64 * w as u64 + x as u64, at: Some([x, y]), detail };
+            let texel = |detail: String| Example {
+                kind: "texel",
+                index: y as u64 * w as u64 + x as u64,
+                at: Some([x, y]),
+                detail,
+            };
             if !n.iter().all(|v| v.is_finite()) {
                 nonunit += 1;
                 w_nu.push(f64::INFINITY, || texel(format!("decodes to {n:?}")));
@@ -169,25 +180,54 @@ pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut 
             let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             if (len - 1.0).abs() > 0.1 {
                 nonunit += 1;
-                w_nu.push((len - 1.0).abs() as f64, || texel(format!("decodes to ({:.3}, {:.3}, {:.3}), length {len:.3}", n[0], n[1], n[2])));
+                w_nu.push((len - 1.0).abs() as f64, || {
+                    texel(format!("decodes to ({:.3}, {:.3}, {:.3}), length {len:.3}", n[0], n[1], n[2]))
+                });
             }
             if n[0].abs() < 0.02 && n[1].abs() < 0.02 && n[2] > 0.98 {
                 flat += 1;
             }
         }
     }
-    s.check(Code::NORMALMAP_Z_NEGATIVE, (neg > 0).then(|| {
-        Finding::new(Code::NORMALMAP_Z_NEGATIVE, neg, total, "texels", format!("{neg} of {total} texels decode to z < 0 (pointing into the surface)"))
+    s.check(
+        Code::NORMALMAP_Z_NEGATIVE,
+        (neg > 0).then(|| {
+            Finding::new(
+                Code::NORMALMAP_Z_NEGATIVE,
+                neg,
+                total,
+                "texels",
+                format!("{neg} of {total} texels decode to z < 0 (pointing into the surface)"),
+            )
             .examples(w_neg.into_examples())
-    }));
-    s.check(Code::NORMALMAP_NOT_UNIT, (nonunit > 0).then(|| {
-        Finding::new(Code::NORMALMAP_NOT_UNIT, nonunit, total, "texels", format!("{nonunit} of {total} texels decode to vectors more than 10% off unit length"))
+        }),
+    );
+    s.check(
+        Code::NORMALMAP_NOT_UNIT,
+        (nonunit > 0).then(|| {
+            Finding::new(
+                Code::NORMALMAP_NOT_UNIT,
+                nonunit,
+                total,
+                "texels",
+                format!("{nonunit} of {total} texels decode to vectors more than 10% off unit length"),
+            )
             .examples(w_nu.into_examples())
-    }));
+        }),
+    );
     let all_flat = total > 0 && flat == total;
-    s.check(Code::NORMALMAP_FLAT, all_flat.then(|| {
-        Finding::new(Code::NORMALMAP_FLAT, total, total, "texels", format!("every texel of this {w}x{h} map is the flat normal (0, 0, 1)"))
-    }));
+    s.check(
+        Code::NORMALMAP_FLAT,
+        all_flat.then(|| {
+            Finding::new(
+                Code::NORMALMAP_FLAT,
+                total,
+                total,
+                "texels",
+                format!("every texel of this {w}x{h} map is the flat normal (0, 0, 1)"),
+            )
+        }),
+    );
     if all_flat {
         return;
     }
@@ -197,7 +237,11 @@ pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut 
 }
 
 fn green_finding(d: &Detection, expected: Convention, wanted_by: &str) -> Option<Finding> {
-    if expected == Convention::Unknown || d.convention == Convention::Unknown || d.convention == expected || d.confidence < REPORT_CONFIDENCE {
+    if expected == Convention::Unknown
+        || d.convention == Convention::Unknown
+        || d.convention == expected
+        || d.confidence < REPORT_CONFIDENCE
+    {
         return None;
     }
     let hint = match expected {

@@ -34,7 +34,11 @@ pub fn text(r: &Report) -> String {
                 }
             }
             if let Some(d) = &sub.convention {
-                let verdict = if d.confidence >= super::normal_image::REPORT_CONFIDENCE { format!("looks {}", d.convention.describe()) } else { "undetermined".into() };
+                let verdict = if d.confidence >= super::normal_image::REPORT_CONFIDENCE {
+                    format!("looks {}", d.convention.describe())
+                } else {
+                    "undetermined".into()
+                };
                 out += &format!("  {}: green channel {verdict} (confidence {:.2})\n", sub.name, d.confidence);
             }
             let mut findings: Vec<&Finding> = sub.findings.iter().collect();
@@ -117,7 +121,8 @@ pub fn junit(r: &Report) -> String {
         for sub in &file.subjects {
             for code in &sub.checks {
                 tests += 1;
-                cases += &format!("    <testcase classname=\"{}\" name=\"{}: {}\">\n", xml(&path), xml(&sub.name), code);
+                cases +=
+                    &format!("    <testcase classname=\"{}\" name=\"{}: {}\">\n", xml(&path), xml(&sub.name), code);
                 for f in sub.findings.iter().filter(|f| f.code == *code) {
                     if r.fails(f.severity) {
                         failures += 1;
@@ -128,7 +133,10 @@ pub fn junit(r: &Report) -> String {
                             xml(&details(f))
                         );
                     } else {
-                        cases += &format!("      <system-out>{}</system-out>\n", xml(&format!("{}: {}", f.severity.as_str(), details(f))));
+                        cases += &format!(
+                            "      <system-out>{}</system-out>\n",
+                            xml(&format!("{}: {}", f.severity.as_str(), details(f)))
+                        );
                     }
                 }
                 cases += "    </testcase>\n";
@@ -136,7 +144,10 @@ pub fn junit(r: &Report) -> String {
         }
         all_tests += tests;
         all_fail += failures;
-        suites += &format!("  <testsuite name=\"{}\" tests=\"{tests}\" failures=\"{failures}\" errors=\"0\">\n{cases}  </testsuite>\n", xml(&path));
+        suites += &format!(
+            "  <testsuite name=\"{}\" tests=\"{tests}\" failures=\"{failures}\" errors=\"0\">\n{cases}  </testsuite>\n",
+            xml(&path)
+        );
     }
     format!(
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"bumpbake validate\" tests=\"{all_tests}\" failures=\"{all_fail}\" errors=\"0\">\n{suites}</testsuites>\n"
@@ -168,7 +179,12 @@ pub fn github(r: &Report) -> String {
             msg += &format!(" (e.g. {} {}: {})", e.kind, e.index, e.detail);
         }
         msg += &format!("\nfix: {}", f.hint);
-        out += &format!("::{level} file={},title={}::{}\n", gh_prop(&file.path.display().to_string()), gh_prop(f.code.as_str()), gh_data(&msg));
+        out += &format!(
+            "::{level} file={},title={}::{}\n",
+            gh_prop(&file.path.display().to_string()),
+            gh_prop(f.code.as_str()),
+            gh_data(&msg)
+        );
     }
     out
 }

@@ -27,13 +27,22 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             None
         };
         if let Some(why) = why {
-            s.check(Code::PRIMITIVE_NOT_CHECKED, Some(Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", format!("not checked: {why}"))));
+            s.check(
+                Code::PRIMITIVE_NOT_CHECKED,
+                Some(Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", format!("not checked: {why}"))),
+            );
             subjects.push((s, None));
             continue;
         }
         let p = to_triangle_list(scene.primitive(r)?);
         if p.attr("POSITION").map(|s| s.len()) != Some(p.vertex_count()) {
-            let f = Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", "not checked: no usable POSITION attribute");
+            let f = Finding::new(
+                Code::PRIMITIVE_NOT_CHECKED,
+                1,
+                1,
+                "primitives",
+                "not checked: no usable POSITION attribute",
+            );
             s.check(Code::PRIMITIVE_NOT_CHECKED, Some(f));
             subjects.push((s, None));
             continue;
@@ -81,17 +90,44 @@ fn check_primitive(d: &PrimData, uses_map: bool, max_angle_deg: f64, from_obj: b
     let has_n = d.normals.is_some();
     // OBJ cannot store tangents: the renderer that loads it always makes its own.
     if uses_map && !from_obj {
-        s.check(Code::TANGENT_MISSING, (!has_t).then(|| {
-            Finding::new(Code::TANGENT_MISSING, 1, 1, "primitives", "the material has a normal texture, but the primitive has no TANGENT")
-        }));
+        s.check(
+            Code::TANGENT_MISSING,
+            (!has_t).then(|| {
+                Finding::new(
+                    Code::TANGENT_MISSING,
+                    1,
+                    1,
+                    "primitives",
+                    "the material has a normal texture, but the primitive has no TANGENT",
+                )
+            }),
+        );
     }
     if has_t {
-        s.check(Code::TANGENT_UNUSED, (!uses_map).then(|| {
-            Finding::new(Code::TANGENT_UNUSED, 1, 1, "primitives", "TANGENT is present but no normal texture reads it")
-        }));
-        s.check(Code::TANGENT_WITHOUT_NORMAL, (!has_n).then(|| {
-            Finding::new(Code::TANGENT_WITHOUT_NORMAL, 1, 1, "primitives", "TANGENT without NORMAL: clients must compute flat normals and ignore the tangents")
-        }));
+        s.check(
+            Code::TANGENT_UNUSED,
+            (!uses_map).then(|| {
+                Finding::new(
+                    Code::TANGENT_UNUSED,
+                    1,
+                    1,
+                    "primitives",
+                    "TANGENT is present but no normal texture reads it",
+                )
+            }),
+        );
+        s.check(
+            Code::TANGENT_WITHOUT_NORMAL,
+            (!has_n).then(|| {
+                Finding::new(
+                    Code::TANGENT_WITHOUT_NORMAL,
+                    1,
+                    1,
+                    "primitives",
+                    "TANGENT without NORMAL: clients must compute flat normals and ignore the tangents",
+                )
+            }),
+        );
     }
     if !(uses_map || has_t) {
         return;
@@ -156,14 +192,27 @@ fn check_nodes(scene: &Scene) -> Option<Subject> {
             kind: "node",
             index: i as u64,
             at: None,
-            detail: format!("node {i}{} shows mesh {} mirrored", nodes[i].get("name").and_then(|x| x.as_str()).map(|x| format!(" ('{x}')")).unwrap_or_default(), nodes[i]["mesh"]),
+            detail: format!(
+                "node {i}{} shows mesh {} mirrored",
+                nodes[i].get("name").and_then(|x| x.as_str()).map(|x| format!(" ('{x}')")).unwrap_or_default(),
+                nodes[i]["mesh"]
+            ),
         });
     }
     let (count, total) = (mirrored.len(), with_mesh.len());
-    s.check(Code::NODE_MIRRORED, (count > 0).then(|| {
-        Finding::new(Code::NODE_MIRRORED, count, total, "nodes", format!("{count} of {total} mesh nodes have a negative-determinant (mirroring) world transform"))
+    s.check(
+        Code::NODE_MIRRORED,
+        (count > 0).then(|| {
+            Finding::new(
+                Code::NODE_MIRRORED,
+                count,
+                total,
+                "nodes",
+                format!("{count} of {total} mesh nodes have a negative-determinant (mirroring) world transform"),
+            )
             .examples(worst.into_examples())
-    }));
+        }),
+    );
     Some(s)
 }
 
@@ -171,7 +220,8 @@ fn local_det_sign(node: &Value) -> i8 {
     let num = |v: &Value| v.as_f64().unwrap_or(0.0);
     let det = if let Some(m) = node.get("matrix").and_then(|m| m.as_array()).filter(|m| m.len() == 16) {
         let e = |c: usize, r: usize| num(&m[c * 4 + r]);
-        e(0, 0) * (e(1, 1) * e(2, 2) - e(2, 1) * e(1, 2)) - e(1, 0) * (e(0, 1) * e(2, 2) - e(2, 1) * e(0, 2)) + e(2, 0) * (e(0, 1) * e(1, 2) - e(1, 1) * e(0, 2))
+        e(0, 0) * (e(1, 1) * e(2, 2) - e(2, 1) * e(1, 2)) - e(1, 0) * (e(0, 1) * e(2, 2) - e(2, 1) * e(0, 2))
+            + e(2, 0) * (e(0, 1) * e(1, 2) - e(1, 1) * e(0, 2))
     } else if let Some(sc) = node.get("scale").and_then(|s| s.as_array()).filter(|s| s.len() == 3) {
         num(&sc[0]) * num(&sc[1]) * num(&sc[2])
     } else {
@@ -189,8 +239,14 @@ fn check_images(scene: &Scene) -> Vec<Subject> {
     let mut users: BTreeMap<usize, Vec<String>> = BTreeMap::new();
     for (m, mat) in scene.json.get("materials").and_then(|m| m.as_array()).into_iter().flatten().enumerate() {
         let Some(tex) = mat.pointer("/normalTexture/index").and_then(|i| i.as_u64()) else { continue };
-        let Some(img) = scene.json.pointer(&format!("/textures/{tex}/source")).and_then(|i| i.as_u64()) else { continue };
-        let name = mat.get("name").and_then(|n| n.as_str()).map(|n| format!("material {m} ('{n}')")).unwrap_or(format!("material {m}"));
+        let Some(img) = scene.json.pointer(&format!("/textures/{tex}/source")).and_then(|i| i.as_u64()) else {
+            continue;
+        };
+        let name = mat
+            .get("name")
+            .and_then(|n| n.as_str())
+            .map(|n| format!("material {m} ('{n}')"))
+            .unwrap_or(format!("material {m}"));
         users.entry(img as usize).or_default().push(name);
     }
     users
@@ -206,9 +262,20 @@ fn check_images(scene: &Scene) -> Vec<Subject> {
             let mut s = Subject::new("image", label);
             s.image = Some(i);
             let wanted_by = format!("{} (glTF normalTexture)", mats.join(", "));
-            match image_bytes(scene, &img_json).and_then(|b| image::load_from_memory(&b).map_err(|e| format!("cannot decode: {e}"))) {
+            match image_bytes(scene, &img_json)
+                .and_then(|b| image::load_from_memory(&b).map_err(|e| format!("cannot decode: {e}")))
+            {
                 Ok(img) => normal_image::check(&img, Convention::OpenGl, &wanted_by, &mut s),
-                Err(e) => s.check(Code::NORMALMAP_UNREADABLE, Some(Finding::new(Code::NORMALMAP_UNREADABLE, 1, 1, "images", format!("normal texture not checked: {e}")))),
+                Err(e) => s.check(
+                    Code::NORMALMAP_UNREADABLE,
+                    Some(Finding::new(
+                        Code::NORMALMAP_UNREADABLE,
+                        1,
+                        1,
+                        "images",
+                        format!("normal texture not checked: {e}"),
+                    )),
+                ),
             }
             s
         })
@@ -217,7 +284,8 @@ fn check_images(scene: &Scene) -> Vec<Subject> {
 
 fn image_bytes(scene: &Scene, img: &Value) -> std::result::Result<Vec<u8>, String> {
     if let Some(uri) = img.get("uri").and_then(|u| u.as_str()) {
-        return crate::scene::uri::read(uri, &scene.base_dir, &scene.source, scene.allow_outside).map_err(|e| e.to_string());
+        return crate::scene::uri::read(uri, &scene.base_dir, &scene.source, scene.allow_outside)
+            .map_err(|e| e.to_string());
     }
     let view = img.get("bufferView").and_then(|v| v.as_u64()).ok_or("the image has neither uri nor bufferView")?;
     let v = scene.json.pointer(&format!("/bufferViews/{view}")).ok_or(format!("bufferView {view} does not exist"))?;

@@ -76,7 +76,10 @@ pub fn reference(path: &Path) -> Vec<[f32; 4]> {
 }
 
 pub fn angle(a: [f32; 4], b: [f32; 4]) -> f64 {
-    let (a, b) = (glam::DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64), glam::DVec3::new(b[0] as f64, b[1] as f64, b[2] as f64));
+    let (a, b) = (
+        glam::DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64),
+        glam::DVec3::new(b[0] as f64, b[1] as f64, b[2] as f64),
+    );
     let c = a.normalize().dot(b.normalize()).clamp(-1.0, 1.0);
     // acos loses precision near 1; atan2 of cross and dot does not.
     a.normalize().cross(b.normalize()).length().atan2(c)
@@ -166,7 +169,8 @@ impl Gltf {
         let view = &self.json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
         let off = view["byteOffset"].as_u64().unwrap() as usize;
         let n = a["count"].as_u64().unwrap() as usize;
-        let vals: Vec<f32> = (0..n).map(|k| f32::from_le_bytes(self.bin[off + 4 * k..off + 4 * k + 4].try_into().unwrap())).collect();
+        let vals: Vec<f32> =
+            (0..n).map(|k| f32::from_le_bytes(self.bin[off + 4 * k..off + 4 * k + 4].try_into().unwrap())).collect();
         let lo = vals.iter().cloned().fold(f32::INFINITY, f32::min);
         let hi = vals.iter().cloned().fold(f32::NEG_INFINITY, f32::max);
         self.json["accessors"][acc]["min"] = json!([lo]);

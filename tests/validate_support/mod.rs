@@ -12,7 +12,9 @@ pub fn validate(args: &[&str]) -> (i32, Value) {
     a.extend_from_slice(args);
     let out = run(&a);
     let code = out.status.code().expect("exit code");
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("json ({e}): {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr)));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!("json ({e}): {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+    });
     (code, v)
 }
 
@@ -89,7 +91,8 @@ pub fn texture_of(g: &mut Gltf, img: &image::RgbImage) -> usize {
     use base64::Engine as _;
     let t = g.texture();
     let src = g.json["textures"][t]["source"].as_u64().unwrap() as usize;
-    g.json["images"][src]["uri"] = json!(format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png_bytes(img))));
+    g.json["images"][src]["uri"] =
+        json!(format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png_bytes(img))));
     t
 }
 
@@ -135,7 +138,6 @@ pub fn broken(name: &str, p: &Prim, map: bool, extra: &[&str]) -> (i32, Value) {
     validate(&args)
 }
 
-
 /// The attributes of `p` as accessors of `g`, for tests that build their own primitive JSON.
 pub fn attrs_of(g: &mut Gltf, p: &Prim) -> Value {
     let mut attrs = json!({ "POSITION": g.floats(&p.pos, Some(34962)) });
@@ -175,7 +177,8 @@ pub fn write_big_grid(path: &Path, n: usize) {
     let nrm: Vec<[f32; 3]> = pos
         .iter()
         .map(|p| {
-            let (dx, dy) = (2.0 * (p[0] * 40.0).cos() * (p[1] * 30.0).cos(), -1.5 * (p[0] * 40.0).sin() * (p[1] * 30.0).sin());
+            let (dx, dy) =
+                (2.0 * (p[0] * 40.0).cos() * (p[1] * 30.0).cos(), -1.5 * (p[0] * 40.0).sin() * (p[1] * 30.0).sin());
             let l = (dx * dx + dy * dy + 1.0f32).sqrt();
             [-dx / l, -dy / l, 1.0 / l]
         })

@@ -56,25 +56,25 @@ pub(crate) fn group_tangents<W: Welded + ?Sized>(
     let n = c.nrm(rep as usize);
     scratch.clear();
     scratch.extend(members.iter().map(|&k| {
-            let (t, j) = ((k / 3) as usize, (k % 3) as usize);
-            let (s0, t0) = st(t);
-            let s = project(s0, n);
-            let tt = project(t0, n);
-            let gwa = gwa[t];
-            let cc = if gwa {
-                [0.0; 3]
-            } else {
-                let p = [
-                    c.pos(w.attr_corner(3 * t + (j + 1) % 3)),
-                    c.pos(w.attr_corner(3 * t + j)),
-                    c.pos(w.attr_corner(3 * t + (j + 2) % 3)),
-                ];
-                let v0 = project(sub(p[0], p[1]), n);
-                let v1 = project(sub(p[2], p[1]), n);
-                let cos = dot(v0, v1).clamp(-1.0, 1.0);
-                scale(acos(cos), s)
-            };
-            Member { s, t: tt, gwa, c: cc }
+        let (t, j) = ((k / 3) as usize, (k % 3) as usize);
+        let (s0, t0) = st(t);
+        let s = project(s0, n);
+        let tt = project(t0, n);
+        let gwa = gwa[t];
+        let cc = if gwa {
+            [0.0; 3]
+        } else {
+            let p = [
+                c.pos(w.attr_corner(3 * t + (j + 1) % 3)),
+                c.pos(w.attr_corner(3 * t + j)),
+                c.pos(w.attr_corner(3 * t + (j + 2) % 3)),
+            ];
+            let v0 = project(sub(p[0], p[1]), n);
+            let v1 = project(sub(p[2], p[1]), n);
+            let cos = dot(v0, v1).clamp(-1.0, 1.0);
+            scale(acos(cos), s)
+        };
+        Member { s, t: tt, gwa, c: cc }
     }));
     if all_compatible(scratch) {
         // Every sub-group is the whole group: one sum, in member order.
@@ -416,7 +416,8 @@ mod tests {
             large(&ms, &mut a);
             brute(&ms, &mut b);
             for i in 0..m {
-                let same = a[i].iter().zip(&b[i]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
+                let same =
+                    a[i].iter().zip(&b[i]).all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
                 assert!(same, "case {case} member {i}: {:?} vs {:?}", a[i], b[i]);
             }
             // Count cases whose outputs are not all equal (exclusions actually happened).

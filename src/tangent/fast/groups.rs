@@ -30,11 +30,7 @@ fn corner_of<W: Welded + ?Sized>(w: &W, u: usize, rep: u32) -> Option<usize> {
 pub(crate) fn build<W: Welded + ?Sized>(w: &W, nb: &[u32], gwa: &[bool], orient: &mut [bool]) -> Groups {
     let ng = gwa.len();
     let mut assigned = vec![false; 3 * ng];
-    let mut g = Groups {
-        start: vec![0],
-        members: Vec::with_capacity(3 * ng),
-        orient: Vec::new(),
-    };
+    let mut g = Groups { start: vec![0], members: Vec::with_capacity(3 * ng), orient: Vec::new() };
     let mut stack: Vec<u32> = Vec::new();
     for t in 0..ng {
         if gwa[t] {

@@ -33,10 +33,10 @@ mod triangles;
 mod weld;
 
 use super::frames::{Builder, Frames};
-use triangles::Order;
 use super::TriMesh;
 use math::V3;
 use rayon::prelude::*;
+use triangles::Order;
 
 /// Read access to the mesh by input corner id (`3 * face + corner`). Every index has been
 /// checked against the attribute arrays before one is built.
@@ -100,7 +100,17 @@ pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::report::Timings) -> R
     let by_vertex = timings.time("weld", || shortcut::weld(&c, &tri.order, ng));
     let (orient, gwa) = (std::mem::take(&mut tri.orient), std::mem::take(&mut tri.gwa));
     Ok(match by_vertex {
-        Some(of_vertex) => finish(&c, mesh.indices, ByVertex { of_vertex, idx: mesh.indices, order: &tri.order }, true, gwa, orient, &tri.order, ng, timings),
+        Some(of_vertex) => finish(
+            &c,
+            mesh.indices,
+            ByVertex { of_vertex, idx: mesh.indices, order: &tri.order },
+            true,
+            gwa,
+            orient,
+            &tri.order,
+            ng,
+            timings,
+        ),
         None => {
             let w = timings.time("weld", || weld::weld(&c, &tri.order));
             finish(&c, mesh.indices, w, false, gwa, orient, &tri.order, ng, timings)
@@ -228,7 +238,14 @@ const PASS: usize = 1 << 18;
 /// Runs [`accumulate::group_tangents`] on the groups in `groups`, in parallel batches of whole
 /// groups; returns their members' sums. Sorts each group's members (the reference sums in
 /// triangle order).
-fn accumulate_all<W: Welded>(c: &Corners, w: &W, order: &Order, gwa: &[bool], grp: &mut groups::Groups, groups: std::ops::Range<usize>) -> Vec<V3> {
+fn accumulate_all<W: Welded>(
+    c: &Corners,
+    w: &W,
+    order: &Order,
+    gwa: &[bool],
+    grp: &mut groups::Groups,
+    groups: std::ops::Range<usize>,
+) -> Vec<V3> {
     const BATCH: usize = 8192;
     let n_groups = groups.end;
     let (lo, hi) = (grp.start[groups.start] as usize, grp.start[groups.end] as usize);
@@ -240,7 +257,11 @@ fn accumulate_all<W: Welded>(c: &Corners, w: &W, order: &Order, gwa: &[bool], gr
     let t_lo = members.par_iter().map(|&k| k / 3).min().unwrap_or(0) as usize;
     let t_hi = members.par_iter().map(|&k| k / 3 + 1).max().unwrap_or(0) as usize;
     let cache: Vec<(V3, V3)> = if t_hi - t_lo <= 2 * members.len() {
-        (t_lo..t_hi).into_par_iter().with_min_len(1 << 12).map(|t| triangles::first_order(c, order.at(t) as usize)).collect()
+        (t_lo..t_hi)
+            .into_par_iter()
+            .with_min_len(1 << 12)
+            .map(|t| triangles::first_order(c, order.at(t) as usize))
+            .collect()
     } else {
         Vec::new()
     };

@@ -34,8 +34,16 @@ pub(crate) fn build<W: Welded + ?Sized>(w: &W, n_edges: usize, id_space: usize, 
     if n_edges == 0 {
         return nb;
     }
-    let max_i0 = if short_tail { 0 } else { (0..n_edges).into_par_iter().with_min_len(1 << 14).map(|e| i0_of(w, e)).max().unwrap_or(0) };
-    let tail_len = if short_tail { 0 } else { (0..n_edges).into_par_iter().with_min_len(1 << 14).filter(|&e| i0_of(w, e) == max_i0).count() };
+    let max_i0 = if short_tail {
+        0
+    } else {
+        (0..n_edges).into_par_iter().with_min_len(1 << 14).map(|e| i0_of(w, e)).max().unwrap_or(0)
+    };
+    let tail_len = if short_tail {
+        0
+    } else {
+        (0..n_edges).into_par_iter().with_min_len(1 << 14).filter(|&e| i0_of(w, e) == max_i0).count()
+    };
     // Pair every i0 bucket except the quirky last one (when it needs the replay).
     let replay = tail_len >= 3;
     // Edges go to ranges of i0 (chunk by chunk, keeping triangle order), then each range is
@@ -162,7 +170,12 @@ fn pair_range<W: Welded + ?Sized>(w: &W, edges: &[u32], base: u32, span: usize) 
 }
 
 /// Pairs the edges of one `i0` bucket (given in triangle order): runs of equal `i1`.
-fn pair_bucket<W: Welded + ?Sized>(w: &W, bucket: &[u32], scratch: &mut Vec<(u32, u32)>, link: &mut impl FnMut(u32, u32)) {
+fn pair_bucket<W: Welded + ?Sized>(
+    w: &W,
+    bucket: &[u32],
+    scratch: &mut Vec<(u32, u32)>,
+    link: &mut impl FnMut(u32, u32),
+) {
     match bucket.len() {
         0 | 1 => {}
         2 => {

@@ -19,9 +19,9 @@
 //! input vertices (corners sharing an index are equal) instead of the corners.
 
 use super::math::canon_bits;
-use crate::scene::weld::{first_equal, hash_words};
-use super::Corners;
 use super::triangles::Order;
+use super::Corners;
+use crate::scene::weld::{first_equal, hash_words};
 use rayon::prelude::*;
 
 /// Beyond this many edges that could share the largest `i0`, replaying their buckets is not

@@ -76,7 +76,9 @@ fn invalid_and_empty_inputs_do_not_panic() {
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(&b) {
         match (x, y) {
-            (Some(x), Some(y)) => assert!(x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits() || (p.is_nan() && q.is_nan()))),
+            (Some(x), Some(y)) => {
+                assert!(x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits() || (p.is_nan() && q.is_nan())))
+            }
             (None, None) => {}
             _ => panic!("{x:?} vs {y:?}"),
         }

@@ -33,10 +33,7 @@ struct Info {
 fn raw(c: &Corners, f: usize) -> (V3, V3, f32) {
     let v = [c.pos(3 * f), c.pos(3 * f + 1), c.pos(3 * f + 2)];
     let tx = [c.uv(3 * f), c.uv(3 * f + 1), c.uv(3 * f + 2)];
-    let d_tx = [
-        [tx[1][0] - tx[0][0], tx[1][1] - tx[0][1]],
-        [tx[2][0] - tx[0][0], tx[2][1] - tx[0][1]],
-    ];
+    let d_tx = [[tx[1][0] - tx[0][0], tx[1][1] - tx[0][1]], [tx[2][0] - tx[0][0], tx[2][1] - tx[0][1]]];
     let d_v = [sub(v[1], v[0]), sub(v[2], v[0])];
     let signed_area_double = d_tx[0][0] * d_tx[1][1] - d_tx[0][1] * d_tx[1][0];
     let s = sub(scale(d_tx[1][1], d_v[0]), scale(d_tx[0][1], d_v[1]));

@@ -12,8 +12,8 @@
 //! in linear time.
 
 use super::math::{canon_bits, eq3, V3};
-use super::Corners;
 use super::triangles::Order;
+use super::Corners;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -126,7 +126,11 @@ impl Buckets {
 
 /// Positions in list order, gathered once.
 fn list_positions(c: &Corners, order: &Order) -> Vec<V3> {
-    (0..order.len() * 3).into_par_iter().with_min_len(1 << 12).map(|k| c.pos(3 * order.at(k / 3) as usize + k % 3)).collect()
+    (0..order.len() * 3)
+        .into_par_iter()
+        .with_min_len(1 << 12)
+        .map(|k| c.pos(3 * order.at(k / 3) as usize + k % 3))
+        .collect()
 }
 
 /// The welded id [`weld`] gives list entries `ks`, replaying only the buckets they fall in.
@@ -230,7 +234,6 @@ pub(crate) fn weld(c: &Corners, order: &Order) -> Vec<u32> {
     }
     welded
 }
-
 
 /// `merge_verts_fast` of the reference with an explicit stack. Each cell's bounding box is
 /// gathered while its parent is partitioned (min/max ignore NaN and the order of folding; the
