@@ -19,7 +19,10 @@ fn coord() -> impl Strategy<Value = f32> {
     ]
 }
 
-fn mesh() -> impl Strategy<Value = (Vec<[f32; 3]>, Option<Vec<[f32; 3]>>, Vec<[f32; 2]>, Vec<u32>, bool)> {
+/// Positions, optional normals, UVs, indices, and whether the UVs are OBJ-style (v up).
+type Mesh = (Vec<[f32; 3]>, Option<Vec<[f32; 3]>>, Vec<[f32; 2]>, Vec<u32>, bool);
+
+fn mesh() -> impl Strategy<Value = Mesh> {
     (1usize..24).prop_flat_map(|n| {
         (
             prop::collection::vec([coord(), coord(), coord()], n),

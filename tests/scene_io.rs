@@ -44,7 +44,10 @@ fn untouched_parts_of_a_gltf_survive_unchanged() {
     let i = g.indices(&idx);
     let ibm = g.floats(&[[1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]], None);
     let times = g.floats(&[[0.0], [1.0]], None);
-    let rots = g.floats(&[[0.0, 0.0, 0.0, 1.0], [0.0, 0.7071068, 0.0, 0.7071068]], None);
+    let rots = g.floats(
+        &[[0.0, 0.0, 0.0, 1.0], [0.0, std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2]],
+        None,
+    );
     let tex = g.texture();
     let m = g.material(json!({
         "name": "bumpy",

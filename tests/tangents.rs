@@ -116,11 +116,11 @@ fn mirrored_uv_seam_splits_vertices_and_keeps_both_signs() {
     assert_eq!(prim.vertex_count(), 8, "the two seam vertices are split, nothing else");
     let tc = corner_attr::<4>(&scene, P0, "TANGENT");
     // glTF UVs (v down) with u along +x: T = +x, and the frame is right-handed in glTF terms.
-    for c in 0..6 {
-        assert_eq!(tc[c], [1.0, 0.0, 0.0, 1.0], "left quad corner {c}");
+    for (c, t) in tc.iter().enumerate().take(6) {
+        assert_eq!(*t, [1.0, 0.0, 0.0, 1.0], "left quad corner {c}");
     }
-    for c in 6..12 {
-        assert_eq!(tc[c], [-1.0, 0.0, 0.0, -1.0], "mirrored quad corner {c}");
+    for (c, t) in tc.iter().enumerate().take(12).skip(6) {
+        assert_eq!(*t, [-1.0, 0.0, 0.0, -1.0], "mirrored quad corner {c}");
     }
 }
 

@@ -244,11 +244,11 @@ fn dedupe_images(scene: &mut Scene) -> Result<Vec<Removal>> {
     let mut first: HashMap<Vec<u8>, usize> = HashMap::new();
     let mut map: Vec<Option<usize>> = (0..n).map(Some).collect();
     let mut out = Vec::new();
-    for i in 0..n {
+    for (i, slot) in map.iter_mut().enumerate() {
         let Ok(bytes) = scene.image_bytes(i) else { continue };
         match first.get(&bytes) {
             Some(&j) => {
-                map[i] = Some(j);
+                *slot = Some(j);
                 out.push(Removal {
                     what: format!("image {i} {} (same bytes as image {j})", name_of(scene, "images", i)),
                     bytes: bytes.len(),

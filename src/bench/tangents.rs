@@ -252,11 +252,14 @@ pub struct ErrorStats {
     pub corners: usize,
 }
 
+/// The reference engine's frames, with its median and fastest time in ms.
+type Reference = (Vec<Option<[f32; 4]>>, f64, f64);
+
 fn angle_deg(a: [f32; 3], b: [f32; 3]) -> f64 {
     let (a, b) = (a.map(f64::from), b.map(f64::from));
     let la = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
     let lb = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
-    if !(la > 0.0 && lb > 0.0) || !la.is_finite() || !lb.is_finite() {
+    if !(la > 0.0 && lb > 0.0 && la.is_finite() && lb.is_finite()) {
         return 180.0;
     }
     let d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
@@ -428,7 +431,7 @@ pub fn run(opts: &Options, mut progress: impl FnMut(&Row)) -> crate::error::Resu
         let tris = case.triangles();
         let with_ref = opts.engines.contains(&Engine::Bevy) && (opts.reference_max == 0 || tris <= opts.reference_max);
         // The reference runs first; its output is what the other engines are compared with.
-        let mut reference: Option<(Vec<Option<[f32; 4]>>, f64, f64)> = None;
+        let mut reference: Option<Reference> = None;
         if with_ref {
             let (out, mut times) = time_engine(&case, Engine::Bevy, opts.runs);
             let min = times.iter().copied().fold(f64::INFINITY, f64::min);

@@ -140,9 +140,9 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     };
     let mut excluded = 0;
     let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as f64;
-    for i in 0..ok.len() {
+    for (i, &both) in ok.iter().enumerate() {
         let covered = a.coverage[i] > 0.0 || b.coverage[i] > 0.0;
-        let c = if ok[i] {
+        let c = if both {
             let deg = angle_deg(a.normal[i], b.normal[i]);
             angles.push(deg);
             for k in 0..3 {

@@ -105,9 +105,9 @@ impl Prepared {
                 .unwrap_or(0);
             for p in 0..n {
                 let r = PrimRef { mesh, primitive: p };
-                if !prim_cache.contains_key(&r) {
+                if let std::collections::hash_map::Entry::Vacant(e) = prim_cache.entry(r) {
                     let local = cx.local(r)?;
-                    prim_cache.insert(r, local);
+                    e.insert(local);
                 }
                 if let Some(Some(local)) = prim_cache.get(&r) {
                     let material = cx.material(r)?;

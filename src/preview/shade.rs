@@ -88,7 +88,7 @@ impl Light {
     }
 
     /// World-space vector from `p` towards the light (unnormalised, as the vertex shader makes it).
-    fn to_light(&self, p: Vec3) -> Vec3 {
+    fn towards(&self, p: Vec3) -> Vec3 {
         match *self {
             Light::Directional { dir, .. } => -dir,
             Light::Point { pos, .. } | Light::Spot { pos, .. } => pos - p,
@@ -193,7 +193,7 @@ impl Fragment<'_> {
             let c = self.bary[k];
             view += to_ts(eye - p) * c;
             for (l, out) in lights.iter().zip(ls.iter_mut()) {
-                out.0 += to_ts(l.to_light(p)) * c;
+                out.0 += to_ts(l.towards(p)) * c;
                 if let Light::Spot { dir, .. } = l {
                     out.1 += to_ts(*dir) * c;
                 }

@@ -66,12 +66,7 @@ pub struct Stream {
 
 impl Stream {
     pub fn len(&self) -> usize {
-        let s = self.format.elem_size();
-        if s == 0 {
-            0
-        } else {
-            self.data.len() / s
-        }
+        self.data.len().checked_div(self.format.elem_size()).unwrap_or(0)
     }
     pub fn is_empty(&self) -> bool {
         self.len() == 0
@@ -221,7 +216,9 @@ mod tests {
         assert_eq!(n.to_f32::<2>(), [[1.0, 0.0], [0.2, 0.4]]);
         assert_eq!(&*n.as_f32::<2>(), [[1.0, 0.0], [0.2, 0.4]]);
         assert_eq!(&*f.as_f32::<3>(), &*f.to_f32::<3>());
-        assert!(matches!(f.as_f32::<3>(), std::borrow::Cow::Borrowed(_)) || f.data.as_ptr() as usize % 4 != 0);
+        assert!(
+            matches!(f.as_f32::<3>(), std::borrow::Cow::Borrowed(_)) || !(f.data.as_ptr() as usize).is_multiple_of(4)
+        );
         // Misaligned bytes are converted, not misread.
         let mut shifted = vec![0u8];
         shifted.extend_from_slice(&f.data);

@@ -99,13 +99,17 @@ impl Scene {
 /// A reference to an entry past the end of its list: (index, length of the list).
 pub(super) struct Dangling(pub usize, pub usize);
 
+/// Visits every reference to one kind of object (each index mutably, for renumbering) and
+/// returns the indices it saw.
+pub(super) type RefWalker = fn(&mut Value, &mut dyn FnMut(&mut usize)) -> BTreeSet<usize>;
+
 /// Drops the entries of `json[key]` that `refs` does not find (none with `keep_all`) and
 /// renumbers the references; returns how many went. Changes nothing when a reference dangles.
 pub(super) fn drop_unreferenced(
     json: &mut Value,
     key: &str,
     keep_all: bool,
-    refs: fn(&mut Value, &mut dyn FnMut(&mut usize)) -> BTreeSet<usize>,
+    refs: RefWalker,
 ) -> Result<usize, Dangling> {
     let n = json.get(key).and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0);
     let keep: BTreeSet<usize> = if keep_all { (0..n).collect() } else { refs(json, &mut |_| {}) };

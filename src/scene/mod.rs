@@ -423,7 +423,7 @@ impl Scene {
                 }
             }
         }
-        if min_max && s.len() > 0 {
+        if min_max && !s.is_empty() {
             let n = s.format.components();
             let mut lo = vec![f32::INFINITY; n];
             let mut hi = vec![f32::NEG_INFINITY; n];

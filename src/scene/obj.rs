@@ -15,13 +15,7 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mtl_error: RefCell<Option<Error>> = RefCell::new(None);
     let mtl_files: RefCell<Vec<std::path::PathBuf>> = RefCell::new(Vec::new());
-    let load = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
+    let load = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
     let (models, materials) = tobj::load_obj_buf(&mut BufReader::new(bytes), &load, |mtl: &Path| {
         let name = mtl.to_string_lossy();
         mtl_files.borrow_mut().push(base_dir.join(mtl));

@@ -289,8 +289,11 @@ impl SplitPlan {
     }
 }
 
+/// Named streams, as a primitive's attributes or one morph target's.
+pub type Streams = Vec<(String, Stream)>;
+
 /// Expands an indexed primitive to one element per corner (the inverse of [`weld`]).
-pub fn unweld(p: &Primitive) -> (Vec<(String, Stream)>, Vec<Vec<(String, Stream)>>) {
+pub fn unweld(p: &Primitive) -> (Streams, Vec<Streams>) {
     let per_corner =
         |list: &Vec<(String, Stream)>| list.iter().map(|(n, s)| (n.clone(), s.gather(&p.indices))).collect::<Vec<_>>();
     (per_corner(&p.attributes), p.targets.iter().map(per_corner).collect())

@@ -132,9 +132,9 @@ pub fn repair(frames: &mut Frames, at: CornerNormals) -> FallbackCounts {
     // First valid corner of each vertex, to lend from across triangles.
     let n_vertices = at.vertex.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
     let mut by_vertex = vec![usize::MAX; n_vertices];
-    for c in 0..at.normal_of.len() {
-        let v = at.vertex[c] as usize;
-        if by_vertex[v] == usize::MAX && !bad_flag[c] {
+    for (c, (&v, &bad)) in at.vertex.iter().zip(&bad_flag).enumerate() {
+        let v = v as usize;
+        if by_vertex[v] == usize::MAX && !bad {
             by_vertex[v] = c;
         }
     }

@@ -80,6 +80,8 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
     let generated_normals = p.attr("NORMAL").is_none();
+    // Declared before the branch so the engine's input can borrow them in one arm only.
+    #[allow(clippy::type_complexity)]
     let (corner_ids, cp, cu, flat): (Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[f32; 3]>);
     let (normals, normal_of, mut frames) = if generated_normals {
         cp = p.indices.iter().map(|&i| positions[i as usize]).collect();

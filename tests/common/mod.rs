@@ -111,7 +111,7 @@ impl Gltf {
     }
 
     fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let mut v = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
@@ -217,11 +217,11 @@ impl Gltf {
     pub fn write_glb(&mut self, path: &Path) {
         self.json["buffers"] = json!([{ "byteLength": self.bin.len() }]);
         let mut j = serde_json::to_vec(&self.json).unwrap();
-        while j.len() % 4 != 0 {
+        while !j.len().is_multiple_of(4) {
             j.push(b' ');
         }
         let mut b = self.bin.clone();
-        while b.len() % 4 != 0 {
+        while !b.len().is_multiple_of(4) {
             b.push(0);
         }
         let total = 12 + 8 + j.len() + 8 + b.len();
@@ -258,7 +258,10 @@ pub fn tiny_png() -> Vec<u8> {
 }
 
 /// A grid of `n x n` quads in the XY plane facing +Z, UV = position (v down, as glTF stores it).
-pub fn grid(n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u16>) {
+/// Positions, normals, UVs and 16-bit indices of a test mesh.
+pub type Mesh16 = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u16>);
+
+pub fn grid(n: usize) -> Mesh16 {
     let mut p = Vec::new();
     let mut uv = Vec::new();
     for j in 0..=n {

@@ -277,11 +277,8 @@ fn legacy_tail<W: Welded + ?Sized>(w: &W, n_edges: usize, max_i0: u32) -> Vec<u3
         let (mut a, mut b) = (0usize, s.len() - 1);
         // The reference's scans always find an element (the pivot bounds them); `None` would
         // only end the loop, never panic.
-        loop {
-            match (a..s.len()).find(|&l| s[l].0 >= pivot) {
-                Some(x) => a = x,
-                None => break,
-            }
+        while let Some(x) = (a..s.len()).find(|&l| s[l].0 >= pivot) {
+            a = x;
             match (0..=b).rev().find(|&r| s[r].0 <= pivot) {
                 Some(x) => b = x,
                 None => break,

@@ -52,7 +52,7 @@ pub(crate) fn weld(c: &Corners, order: &Order, n_good: usize) -> Option<Vec<u32>
     const HUGE: f32 = f32::MAX / 4.0;
     let unusable = (0..n_vertices).into_par_iter().with_min_len(1 << 14).any(|v| {
         let all = key(v);
-        first[v] != u32::MAX && (all.iter().any(|x| x.is_nan()) || all[..3].iter().any(|x| !(x.abs() < HUGE)))
+        first[v] != u32::MAX && (all.iter().any(|x| x.is_nan()) || all[..3].iter().any(|x| x.abs() >= HUGE))
     });
     if unusable {
         return None; // no shortcut for NaN or huge coordinates

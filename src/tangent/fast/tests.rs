@@ -1,7 +1,10 @@
 use crate::tangent::mikk::{generate as gen, Engine};
 use crate::tangent::TriMesh;
 
-fn cube() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u32>) {
+/// Positions, normals, UVs and indices.
+type Mesh = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u32>);
+
+fn cube() -> Mesh {
     let mut p = Vec::new();
     let mut n = Vec::new();
     let mut uv = Vec::new();
@@ -93,7 +96,7 @@ fn classes(w: &[u32]) -> Vec<usize> {
 
 /// A grid of `n x n` quads with duplicated seam vertices (equal values, other indices), so that
 /// welding merges corners of different vertex indices.
-fn seamed_grid(n: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u32>) {
+fn seamed_grid(n: usize) -> Mesh {
     let (mut p, mut nr, mut uv, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for j in 0..=n {
         for i in 0..=n {

@@ -45,6 +45,7 @@ const EMPTY: BBox = BBox { mn: [f32::INFINITY; 3], mx: [f32::NEG_INFINITY; 3] };
 impl BBox {
     #[inline]
     fn grow(&mut self, p: V3) {
+        #[allow(clippy::needless_range_loop)] // one axis of three arrays at a time
         for c in 0..3 {
             self.mn[c] = if p[c] < self.mn[c] { p[c] } else { self.mn[c] };
             self.mx[c] = if p[c] > self.mx[c] { p[c] } else { self.mx[c] };
@@ -311,11 +312,11 @@ fn partition(b: &mut [Tmp], ax: usize, sep: f32) -> (usize, BBox, BBox) {
     }
     let part = if start < end && b[start].p[ax] < sep { start + 1 } else { start };
     // At most one element is left between the scans; it sits on the side `part` gives it.
-    for i in start..end {
+    for (i, e) in b.iter().enumerate().take(end).skip(start) {
         if i < part {
-            left.grow(b[i].p);
+            left.grow(e.p);
         } else {
-            right.grow(b[i].p);
+            right.grow(e.p);
         }
     }
     (part, left, right)
