@@ -71,8 +71,9 @@ pub fn needs_tangents(
         None => return Err("material has no normal texture".into()),
     };
     if pj.pointer(&format!("/attributes/TEXCOORD_{}", uvs.set)).is_none() {
-        let what = uvs.need.as_ref().map(|n| n.need.describe()).unwrap_or("normal texture");
-        return Err(format!("no UVs (TEXCOORD_{}, which the {what} reads)", uvs.set));
+        let what =
+            uvs.need.as_ref().map(|n| n.describe()).unwrap_or_else(|| format!("TEXCOORD_{} --all reads", uvs.set));
+        return Err(format!("no UVs (the {what}, which the primitive does not have)"));
     }
     Ok(uvs)
 }

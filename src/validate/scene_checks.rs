@@ -4,7 +4,7 @@
 use super::frames::{self, Explained, PrimData};
 use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
 use crate::error::Result;
-use crate::scene::{PrimRef, Scene};
+use crate::scene::{Materials, PrimRef, Scene};
 use crate::tangent::apply::to_triangle_list;
 use rayon::prelude::*;
 use serde_json::Value;
@@ -81,7 +81,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     if let Some(s) = check_nodes(scene) {
         done.push(s);
     }
-    done.extend(check_images(scene));
+    done.extend(check_images(scene, &mats));
     Ok(done)
 }
 
@@ -246,8 +246,7 @@ fn local_det_sign(node: &Value) -> i8 {
 }
 
 /// Each image some material uses as its normal texture (or clearcoat normal texture), checked once.
-fn check_images(scene: &Scene) -> Vec<Subject> {
-    let mats = scene.materials();
+fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
     let users: BTreeMap<usize, Vec<String>> = mats
         .normal_images()
         .into_iter()
