@@ -313,3 +313,32 @@ fn only_scene_reads_material_textures() {
     }
     assert!(bad.is_empty(), "material JSON read outside src/scene/ (use Scene::materials):\n{}", bad.join("\n"));
 }
+
+/// `KHR_animation_pointer` names materials by index inside JSON pointers, which the reference
+/// graph does not rewrite: leave-out keeps every material then, and drops unused ones otherwise.
+#[test]
+fn animation_pointers_keep_materials_in_place() {
+    let d = validated_dir("materials_animation_pointer");
+    let scratch = scratch_dir("materials_animation_pointer");
+    for (name, used) in [("pointer", &["KHR_animation_pointer"][..]), ("plain", &[][..])] {
+        let mut g = Gltf::new();
+        let mut prim = quad(&mut g, false, None);
+        g.material(json!({ "name": "unused" }));
+        prim["material"] = json!(g.material(json!({ "name": "shown" })));
+        g.mesh(prim);
+        if !used.is_empty() {
+            g.json["extensionsUsed"] = json!(used);
+        }
+        let input = g.write_gltf(&scratch, name);
+        let out = d.join(format!("{name}.glb"));
+        run_ok(&["bake", s(&input), "-o", s(&out)]);
+        let names: Vec<String> = load(&out).json["materials"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["name"].as_str().unwrap().to_string())
+            .collect();
+        let want: &[&str] = if used.is_empty() { &["shown"] } else { &["unused", "shown"] };
+        assert_eq!(names, want, "{name}");
+    }
+}
