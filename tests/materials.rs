@@ -93,21 +93,29 @@ fn codes(report: &Value) -> Vec<String> {
 #[test]
 fn tangents_follow_a_rotated_normal_texture() {
     let (d, scratch) = (validated_dir("materials_rotated"), scratch_dir("materials_rotated"));
-    let mut g = Gltf::new();
-    let t = texture(&mut g, &tiny_png());
-    let mut prim = quad(&mut g, false, None);
-    prim["material"] = json!(g.material(json!({ "normalTexture": { "index": t, "extensions": rotated() } })));
-    g.mesh(prim);
-    g.json["extensionsUsed"] = json!(["KHR_texture_transform"]);
-    // Without the tangents its material needs, the input is not a valid glTF: it stays out of
-    // the validated folder.
-    let input = g.write_gltf(&scratch, "in");
-    let out = d.join("out.glb");
-    run_ok(&["tangents", s(&input), "-o", s(&out)]);
-    assert_tangents(&out, ROTATED_T);
-    // The stored UVs stay as they were: only the frames follow the transform.
-    let uv: Vec<[f32; 2]> = corner_attr::<2>(&load(&out), P0, "TEXCOORD_0");
-    assert_eq!(uv, corner_attr::<2>(&load(&input), P0, "TEXCOORD_0"));
+    // Mirrored in u by the transform, `(u, v) -> (1 - u, v)`: T = +u' = -X, and with the image's
+    // up still +Y = cross(N, T) * w, w = -1.
+    let mirrored = json!({ "KHR_texture_transform": { "scale": [-1.0, 1.0], "offset": [1.0, 0.0] } });
+    for (name, transform, want) in [("rotated", rotated(), ROTATED_T), ("mirrored", mirrored, [-1.0, 0.0, 0.0, -1.0])] {
+        let mut g = Gltf::new();
+        let t = texture(&mut g, &tiny_png());
+        let mut prim = quad(&mut g, false, None);
+        prim["material"] = json!(g.material(json!({ "normalTexture": { "index": t, "extensions": transform } })));
+        g.mesh(prim);
+        g.json["extensionsUsed"] = json!(["KHR_texture_transform"]);
+        // Without the tangents its material needs, the input is not a valid glTF: it stays out of
+        // the validated folder.
+        let input = g.write_gltf(&scratch, name);
+        let out = d.join(format!("{name}.glb"));
+        run_ok(&["tangents", s(&input), "-o", s(&out)]);
+        assert_tangents(&out, want);
+        // The stored UVs stay as they were: only the frames follow the transform.
+        let uv: Vec<[f32; 2]> = corner_attr::<2>(&load(&out), P0, "TEXCOORD_0");
+        assert_eq!(uv, corner_attr::<2>(&load(&input), P0, "TEXCOORD_0"));
+        // And validate agrees with what tangents made.
+        let (_, r) = validate(&[s(&out)]);
+        assert!(codes(&r).iter().all(|c| !c.starts_with("TANGENT")), "{name}: {r:#}");
+    }
 }
 
 #[test]
