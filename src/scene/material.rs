@@ -160,7 +160,7 @@ pub struct TextureUse {
     /// `KHR_texture_transform`, unless it changes nothing.
     pub transform: Option<UvTransform>,
     pub sampler: Option<usize>,
-    /// The images the texture names: its plain `source` first (what every client can decode),
+    /// The images the texture names: its plain `source` first (the core formats, PNG or JPEG),
     /// then those of image-format extensions (what a client supporting them shows instead).
     pub images: Vec<ImageSource>,
     pub colour: ColourSpace,
@@ -220,7 +220,7 @@ impl MaterialInfo {
     pub fn tangents(&self) -> Option<&TangentNeed> {
         self.tangent_needs.first()
     }
-    /// `Some('name')` formatted for messages: `material 2 ('rock')`.
+    /// The material as messages name it: `material 2 ('rock')`, or `material 2` without a name.
     pub fn label(&self) -> String {
         match &self.name {
             Some(n) => format!("material {} ('{n}')", self.index),
