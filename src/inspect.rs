@@ -126,7 +126,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
                 base_color_image: m.texture(Slot::BaseColor).and_then(|t| t.image()),
                 normal_image: nt.and_then(|t| t.image()),
                 normal_tex_coord: nt.map(|t| t.tex_coord),
-                normal_scale: nt.map(|t| t.scale.unwrap_or(1.0) as f64),
+                normal_scale: nt.map(|t| t.scale.unwrap_or(1.0)),
                 height_map: scene.height_maps.iter().find(|h| h.material == m.index).map(|h| h.path.clone()),
                 tangents_needed_by: m
                     .tangent_needs

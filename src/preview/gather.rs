@@ -282,7 +282,7 @@ impl Cx<'_> {
         }
         if let Some(t) = info.texture(Slot::Normal) {
             m.normal_texture = self.tex_ref(t, false)?;
-            m.normal_scale = t.scale.unwrap_or(1.0);
+            m.normal_scale = t.scale.unwrap_or(1.0) as f32;
         }
         m.double_sided = info.double_sided;
         Ok(m)

@@ -165,7 +165,7 @@ pub struct TextureUse {
     pub images: Vec<ImageSource>,
     pub colour: ColourSpace,
     /// `scale` of a normal texture, `strength` of an occlusion texture.
-    pub scale: Option<f32>,
+    pub scale: Option<f64>,
 }
 
 impl TextureUse {
@@ -423,7 +423,7 @@ impl Scene {
             sampler: tj.and_then(|t| t.get("sampler")).and_then(as_index),
             images,
             colour,
-            scale: info.get(scale_key).and_then(|s| s.as_f64()).map(|s| s as f32).filter(|s| s.is_finite()),
+            scale: info.get(scale_key).and_then(|s| s.as_f64()).filter(|s| s.is_finite()),
         })
     }
 
