@@ -2,7 +2,8 @@
 //! materials and the textures they use, tangent presence and need, image sizes and bit depths.
 
 use crate::error::Result;
-use crate::scene::{ReadOptions, Scene};
+use crate::scene::material::TextureUse;
+use crate::scene::{ReadOptions, Scene, Slot};
 use crate::tangent::apply::needs_tangents;
 use serde::Serialize;
 use serde_json::Value;
@@ -36,6 +37,10 @@ pub struct PrimInfo {
     pub has_tangents: bool,
     /// The UV set tangents must come from, or why none are needed.
     pub tangents_needed_from: Option<String>,
+    /// What needs them (`normal texture reads TEXCOORD_0`, ...).
+    pub tangents_needed_by: Option<String>,
+    /// Materials of the primitive (variants) whose textures read other UVs than the tangents follow.
+    pub tangent_conflicts: Vec<String>,
     pub tangents_not_needed: Option<String>,
 }
 
@@ -56,6 +61,10 @@ pub struct MaterialInfo {
     pub normal_tex_coord: Option<u32>,
     pub normal_scale: Option<f64>,
     pub height_map: Option<PathBuf>,
+    /// What needs tangents in this material, most important first.
+    pub tangents_needed_by: Vec<String>,
+    /// Every texture the material reads.
+    pub textures: Vec<TextureUse>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -74,12 +83,14 @@ pub struct ImageInfo {
 pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let scene = Scene::read(path, opts)?;
     let arr = |k: &str| scene.json.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
+    let mats = scene.materials();
     let mut primitives = Vec::new();
     for r in scene.primitives() {
         let pj = scene.prim_json(r).clone();
         let p = scene.primitive(r)?;
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
-        let need = needs_tangents(&scene, r, false);
+        let need = needs_tangents(&scene, &mats, r, false);
+        let by = need.as_ref().ok().and_then(|u| u.need.as_ref());
         primitives.push(PrimInfo {
             mesh: r.mesh,
             primitive: r.primitive,
@@ -99,26 +110,31 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
                 .collect(),
             morph_targets: p.targets.len(),
             has_tangents: p.attr("TANGENT").is_some(),
-            tangents_needed_from: need.as_ref().ok().map(|s| format!("TEXCOORD_{s}")),
+            tangents_needed_from: need.as_ref().ok().map(|u| format!("TEXCOORD_{}", u.set)),
+            tangents_needed_by: by.map(|n| n.describe()),
+            tangent_conflicts: by.map(|n| n.conflicts.clone()).unwrap_or_default(),
             tangents_not_needed: need.err(),
         });
     }
-    let materials = arr("materials")
-        .iter()
-        .enumerate()
-        .map(|(i, m)| {
-            let tex_image = |v: Option<&Value>| {
-                v.and_then(|t| t.get("index")).and_then(|t| t.as_u64()).and_then(|t| scene.texture_image(t as usize))
-            };
-            let nt = m.get("normalTexture");
+    let materials = mats
+        .list
+        .into_iter()
+        .map(|m| {
+            let nt = m.texture(Slot::Normal);
             MaterialInfo {
-                index: i,
-                name: m.get("name").and_then(|n| n.as_str()).map(String::from),
-                base_color_image: tex_image(m.pointer("/pbrMetallicRoughness/baseColorTexture")),
-                normal_image: tex_image(nt),
-                normal_tex_coord: nt.map(|t| t.get("texCoord").and_then(|c| c.as_u64()).unwrap_or(0) as u32),
-                normal_scale: nt.map(|t| t.get("scale").and_then(|c| c.as_f64()).unwrap_or(1.0)),
-                height_map: scene.height_maps.iter().find(|h| h.material == i).map(|h| h.path.clone()),
+                index: m.index,
+                base_color_image: m.texture(Slot::BaseColor).and_then(|t| t.image()),
+                normal_image: nt.and_then(|t| t.image()),
+                normal_tex_coord: nt.map(|t| t.tex_coord),
+                normal_scale: nt.map(|t| t.scale.unwrap_or(1.0)),
+                height_map: scene.height_maps.iter().find(|h| h.material == m.index).map(|h| h.path.clone()),
+                tangents_needed_by: m
+                    .tangent_needs
+                    .iter()
+                    .map(|n| format!("{} (TEXCOORD_{})", n.describe(), n.tex_coord))
+                    .collect(),
+                name: m.name,
+                textures: m.textures,
             }
         })
         .collect();
@@ -212,13 +228,17 @@ impl Inspection {
                 p.material.map(|m| m.to_string()).unwrap_or("-".into()),
                 attrs.join(", ")
             );
+            let by = |uv: &str| p.tangents_needed_by.clone().unwrap_or_else(|| format!("--all reads {uv}"));
             let t = match (&p.tangents_needed_from, p.has_tangents) {
-                (Some(uv), true) => format!("present; needed (normal texture reads {uv})"),
-                (Some(uv), false) => format!("MISSING; needed (normal texture reads {uv})"),
+                (Some(uv), true) => format!("present; needed ({})", by(uv)),
+                (Some(uv), false) => format!("MISSING; needed ({})", by(uv)),
                 (None, true) => format!("present but unused ({})", p.tangents_not_needed.as_deref().unwrap_or("")),
                 (None, false) => format!("none; not needed ({})", p.tangents_not_needed.as_deref().unwrap_or("")),
             };
             s += &format!("    tangents: {t}\n");
+            for c in &p.tangent_conflicts {
+                s += &format!("    note: {c}\n");
+            }
         }
         for m in &self.materials {
             s += &format!("  material {} {}: ", m.index, m.name.as_deref().unwrap_or(""));
@@ -235,6 +255,13 @@ impl Inspection {
             }
             if let Some(h) = &m.height_map {
                 parts.push(format!("height map {}", h.display()));
+            }
+            for t in m.textures.iter().filter(|t| !matches!(t.slot, Slot::BaseColor | Slot::Normal)) {
+                let img = t.image().map(|i| format!("image {i}")).unwrap_or_else(|| "no image".into());
+                parts.push(format!("{:?} {img} (TEXCOORD_{})", t.slot, t.tex_coord));
+            }
+            if !m.tangents_needed_by.is_empty() {
+                parts.push(format!("needs tangents: {}", m.tangents_needed_by.join(", ")));
             }
             s += &(if parts.is_empty() { "no textures".to_string() } else { parts.join(", ") } + "\n");
         }

@@ -1,13 +1,14 @@
-//! Leaving out what the scene does not need: tangents where no normal texture reads them, UV sets
-//! no texture reads, `_BITANGENT` unless asked for, materials, textures, images and samplers
+//! Leaving out what the scene does not need: tangents where no material the primitive can show
+//! needs them (see [`crate::scene::material`]), UV sets no texture reads, `_BITANGENT` unless asked for, materials, textures, images and samplers
 //! nothing references, and images that are the same bytes. Accessors and buffer views that fall
 //! out of use are dropped by the writer. Nothing a node, animation, skin, morph target or known
 //! extension references is removed; with an unknown extension in use, only the attributes go.
 
 use crate::error::Result;
+use crate::scene::refs::{self, Walker};
 use crate::scene::{PrimRef, Scene};
-use serde_json::{json, Value};
-use std::collections::{BTreeSet, HashMap};
+use serde_json::Value;
+use std::collections::HashMap;
 
 /// One thing left out, and the bytes it took.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -16,67 +17,14 @@ pub struct Removal {
     pub bytes: usize,
 }
 
-/// Extensions whose texture and image references [`texture_refs`] and [`image_refs`] follow.
-const KNOWN: &[&str] = &[
-    "KHR_texture_transform",
-    "KHR_lights_punctual",
-    "KHR_materials_clearcoat",
-    "KHR_materials_emissive_strength",
-    "KHR_materials_ior",
-    "KHR_materials_iridescence",
-    "KHR_materials_sheen",
-    "KHR_materials_specular",
-    "KHR_materials_transmission",
-    "KHR_materials_unlit",
-    "KHR_materials_variants",
-    "KHR_materials_volume",
-    "KHR_materials_anisotropy",
-    "KHR_materials_dispersion",
-    "KHR_mesh_quantization",
-    "KHR_texture_basisu",
-    "EXT_texture_webp",
-    "EXT_mesh_gpu_instancing",
-];
-
 pub fn leave_out(scene: &mut Scene, keep_bitangents: bool) -> Result<Vec<Removal>> {
     let mut removed = attributes(scene, keep_bitangents)?;
-    let unknown = scene
-        .json
-        .get("extensionsUsed")
-        .and_then(|e| e.as_array())
-        .map(|l| l.iter().any(|e| !KNOWN.contains(&e.as_str().unwrap_or(""))))
-        .unwrap_or(false);
-    if !unknown {
+    if !refs::unknown_object_refs(&scene.json) {
         removed.extend(materials(scene));
         removed.extend(dedupe_images(scene)?);
         removed.extend(textures_images_samplers(scene)?);
     }
     Ok(removed)
-}
-
-/// Every texture-info object in a material (`baseColorTexture`, `normalTexture`, extensions').
-fn texture_infos(v: &mut Value, f: &mut dyn FnMut(&mut Value)) {
-    if let Some(o) = v.as_object_mut() {
-        for (k, child) in o.iter_mut() {
-            if k.ends_with("Texture") && child.get("index").is_some() {
-                f(child);
-            }
-            texture_infos(child, f);
-        }
-    }
-}
-
-/// The UV sets a material's textures read.
-fn used_sets(material: Option<&Value>) -> BTreeSet<u64> {
-    let mut sets = BTreeSet::new();
-    if let Some(m) = material {
-        let mut m = m.clone();
-        texture_infos(&mut m, &mut |t| {
-            let over = t.pointer("/extensions/KHR_texture_transform/texCoord").and_then(|c| c.as_u64());
-            sets.insert(over.or_else(|| t.get("texCoord").and_then(|c| c.as_u64())).unwrap_or(0));
-        });
-    }
-    sets
 }
 
 fn accessor_bytes(scene: &Scene, idx: Option<u64>) -> usize {
@@ -92,10 +40,10 @@ fn accessor_bytes(scene: &Scene, idx: Option<u64>) -> usize {
 
 fn attributes(scene: &mut Scene, keep_bitangents: bool) -> Result<Vec<Removal>> {
     let mut out = Vec::new();
+    let mats = scene.materials();
     for r in scene.primitives() {
-        let has_normal_tex = scene.normal_texcoord(r).is_some();
-        let sets = used_sets(scene.material_of(r));
-        let max_set = sets.iter().next_back().copied();
+        let needs_tangents = mats.tangent_need(scene, r).is_some();
+        let max_set = mats.uv_sets(scene, r).into_iter().next_back();
         let names: Vec<String> = scene
             .prim_json(r)
             .get("attributes")
@@ -104,13 +52,13 @@ fn attributes(scene: &mut Scene, keep_bitangents: bool) -> Result<Vec<Removal>> 
             .unwrap_or_default();
         let mut drop = Vec::new();
         for name in names {
-            let why = if name == "TANGENT" && !has_normal_tex {
-                Some("no normal texture reads it")
+            let why = if name == "TANGENT" && !needs_tangents {
+                Some("no normal texture, clearcoat normal texture or anisotropy reads it")
             } else if name == "_BITANGENT" && !keep_bitangents {
                 Some("not asked for (--bitangents)")
             } else if let Some(k) = name.strip_prefix("TEXCOORD_").and_then(|k| k.parse::<u64>().ok()) {
                 // Only trailing sets go: glTF wants TEXCOORD_0..n without gaps.
-                (max_set.map(|m| k > m).unwrap_or(true)).then_some("no texture reads it")
+                (max_set.map(|m| k > m as u64).unwrap_or(true)).then_some("no texture reads it")
             } else {
                 None
             };
@@ -145,76 +93,25 @@ fn len(scene: &Scene, key: &str) -> usize {
     scene.json.get(key).and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0)
 }
 
-/// Keeps `keep` of `json[key]`, returns old -> new index.
-fn compact(scene: &mut Scene, key: &str, keep: &BTreeSet<usize>) -> Vec<Option<usize>> {
-    let list = scene.json.get(key).and_then(|a| a.as_array()).cloned().unwrap_or_default();
-    let mut map = vec![None; list.len()];
-    let mut kept = Vec::new();
-    for (i, item) in list.into_iter().enumerate() {
-        if keep.contains(&i) {
-            map[i] = Some(kept.len());
-            kept.push(item);
-        }
-    }
-    if kept.is_empty() {
+/// Drops the entries of `json[key]` that `walk` finds no reference to and renumbers the rest;
+/// returns the indices that went. A list left empty goes too. Nothing changes when a reference
+/// dangles (the file is broken there; the writer names it).
+fn drop_unused(scene: &mut Scene, key: &str, walk: Walker) -> Vec<usize> {
+    let Ok(d) = refs::drop_unreferenced(&mut scene.json, key, false, walk) else { return Vec::new() };
+    if len(scene, key) == 0 {
         if let Some(o) = scene.json.as_object_mut() {
             o.remove(key);
         }
-    } else {
-        scene.json[key] = Value::Array(kept);
     }
-    map
-}
-
-fn remap(v: &mut Value, map: &[Option<usize>]) {
-    if let Some(i) = v.as_u64().and_then(|i| map.get(i as usize).copied().flatten()) {
-        *v = json!(i);
-    }
+    d.gone
 }
 
 fn materials(scene: &mut Scene) -> Vec<Removal> {
-    let n = len(scene, "materials");
-    let mut keep = BTreeSet::new();
-    for r in scene.primitives() {
-        let pj = scene.prim_json(r);
-        if let Some(m) = pj.get("material").and_then(|m| m.as_u64()) {
-            keep.insert(m as usize);
-        }
-        for mapping in
-            pj.pointer("/extensions/KHR_materials_variants/mappings").and_then(|m| m.as_array()).into_iter().flatten()
-        {
-            if let Some(m) = mapping.get("material").and_then(|m| m.as_u64()) {
-                keep.insert(m as usize);
-            }
-        }
-    }
-    keep.retain(|&m| m < n);
-    let removed: Vec<Removal> = (0..n)
-        .filter(|i| !keep.contains(i))
-        .map(|i| Removal {
-            what: format!("material {i} {} (no primitive uses it)", name_of(scene, "materials", i)),
-            bytes: 0,
-        })
-        .collect();
-    if removed.is_empty() {
-        return removed;
-    }
-    let map = compact(scene, "materials", &keep);
-    for r in scene.primitives() {
-        let pj = prim_mut(scene, r);
-        if let Some(m) = pj.get_mut("material") {
-            remap(m, &map);
-        }
-        if let Some(list) = pj.pointer_mut("/extensions/KHR_materials_variants/mappings").and_then(|m| m.as_array_mut())
-        {
-            for mapping in list {
-                if let Some(m) = mapping.get_mut("material") {
-                    remap(m, &map);
-                }
-            }
-        }
-    }
-    removed
+    let names: Vec<String> = (0..len(scene, "materials")).map(|i| name_of(scene, "materials", i)).collect();
+    drop_unused(scene, "materials", refs::material_refs)
+        .into_iter()
+        .map(|i| Removal { what: format!("material {i} {} (no primitive uses it)", names[i]), bytes: 0 })
+        .collect()
 }
 
 fn name_of(scene: &Scene, key: &str, i: usize) -> String {
@@ -224,18 +121,6 @@ fn name_of(scene: &Scene, key: &str, i: usize) -> String {
         .and_then(|n| n.as_str())
         .map(|n| format!("'{n}'"))
         .unwrap_or_default()
-}
-
-/// Image sources of a texture, including those of texture extensions.
-fn texture_sources(t: &mut Value, f: &mut dyn FnMut(&mut Value)) {
-    if let Some(s) = t.get_mut("source") {
-        f(s);
-    }
-    for ext in ["KHR_texture_basisu", "EXT_texture_webp", "MSFT_texture_dds"] {
-        if let Some(s) = t.pointer_mut(&format!("/extensions/{ext}/source")) {
-            f(s);
-        }
-    }
 }
 
 /// Points every texture at the first image with the same bytes; the rest fall out of use.
@@ -260,78 +145,35 @@ fn dedupe_images(scene: &mut Scene) -> Result<Vec<Removal>> {
         }
     }
     if !out.is_empty() {
-        for t in scene.json.get_mut("textures").and_then(|t| t.as_array_mut()).into_iter().flatten() {
-            texture_sources(t, &mut |s| remap(s, &map));
-        }
+        refs::image_refs(&mut scene.json, &mut |i| *i = map.get(*i).copied().flatten().unwrap_or(*i));
     }
     Ok(out)
 }
 
 fn textures_images_samplers(scene: &mut Scene) -> Result<Vec<Removal>> {
-    let mut out = Vec::new();
     // Textures: what materials read.
-    let n = len(scene, "textures");
-    let mut keep = BTreeSet::new();
-    for m in scene.json.get_mut("materials").and_then(|m| m.as_array_mut()).into_iter().flatten() {
-        texture_infos(m, &mut |t| {
-            if let Some(i) = t.get("index").and_then(|i| i.as_u64()) {
-                keep.insert(i as usize);
-            }
-        });
-    }
-    keep.retain(|&t| t < n);
-    out.extend(
-        (0..n)
-            .filter(|i| !keep.contains(i))
-            .map(|i| Removal { what: format!("texture {i} (no material reads it)"), bytes: 0 }),
-    );
-    let map = compact(scene, "textures", &keep);
-    for m in scene.json.get_mut("materials").and_then(|m| m.as_array_mut()).into_iter().flatten() {
-        texture_infos(m, &mut |t| remap(&mut t["index"], &map));
-    }
-    // Images: what textures show.
-    let n = len(scene, "images");
-    let mut keep = BTreeSet::new();
-    for t in scene.json.get_mut("textures").and_then(|t| t.as_array_mut()).into_iter().flatten() {
-        texture_sources(t, &mut |s| {
-            if let Some(i) = s.as_u64() {
-                keep.insert(i as usize);
-            }
-        });
-    }
-    keep.retain(|&i| i < n);
-    for i in (0..n).filter(|i| !keep.contains(i)) {
-        if !out.iter().any(|r| r.what.starts_with(&format!("image {i} "))) {
-            let bytes = scene.image_bytes(i).map(|b| b.len()).unwrap_or(0);
-            out.push(Removal {
-                what: format!("image {i} {} (no texture shows it)", name_of(scene, "images", i)),
-                bytes,
-            });
+    let mut out: Vec<Removal> = drop_unused(scene, "textures", refs::texture_refs)
+        .into_iter()
+        .map(|i| Removal { what: format!("texture {i} (no material reads it)"), bytes: 0 })
+        .collect();
+    // Images: what textures show (those deduplicated above are already counted).
+    let shown = refs::image_refs(&mut scene.json, &mut |_| {});
+    let unshown: HashMap<usize, (String, usize)> = (0..len(scene, "images"))
+        .filter(|i| !shown.contains(i))
+        .map(|i| (i, (name_of(scene, "images", i), scene.image_bytes(i).map(|b| b.len()).unwrap_or(0))))
+        .collect();
+    for i in drop_unused(scene, "images", refs::image_refs) {
+        if let Some((name, bytes)) =
+            unshown.get(&i).filter(|_| !out.iter().any(|r| r.what.starts_with(&format!("image {i} "))))
+        {
+            out.push(Removal { what: format!("image {i} {name} (no texture shows it)"), bytes: *bytes });
         }
-    }
-    let map = compact(scene, "images", &keep);
-    for t in scene.json.get_mut("textures").and_then(|t| t.as_array_mut()).into_iter().flatten() {
-        texture_sources(t, &mut |s| remap(s, &map));
     }
     // Samplers: what textures use.
-    let n = len(scene, "samplers");
-    let mut keep = BTreeSet::new();
-    for t in scene.json.get("textures").and_then(|t| t.as_array()).into_iter().flatten() {
-        if let Some(s) = t.get("sampler").and_then(|s| s.as_u64()) {
-            keep.insert(s as usize);
-        }
-    }
-    keep.retain(|&s| s < n);
     out.extend(
-        (0..n)
-            .filter(|i| !keep.contains(i))
+        drop_unused(scene, "samplers", refs::sampler_refs)
+            .into_iter()
             .map(|i| Removal { what: format!("sampler {i} (no texture uses it)"), bytes: 0 }),
     );
-    let map = compact(scene, "samplers", &keep);
-    for t in scene.json.get_mut("textures").and_then(|t| t.as_array_mut()).into_iter().flatten() {
-        if let Some(s) = t.get_mut("sampler") {
-            remap(s, &map);
-        }
-    }
     Ok(out)
 }

@@ -3,8 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::normalmap::{self, Channel, Convention, EncodeOptions, Filter, Options, PngSettings, Wrap};
-use crate::scene::Scene;
-use serde_json::Value;
+use crate::scene::{Scene, Slot};
 use std::path::Path;
 
 /// How height maps become normal maps in `bake`.
@@ -34,17 +33,10 @@ impl Default for HeightSettings {
 /// The wrap mode a material's textures sample with: the sampler of its normal texture, else of
 /// its base colour texture, else glTF's default (repeat). A map's filter must wrap the same way.
 pub fn material_wrap(scene: &Scene, material: usize) -> Wrap {
-    let m = &scene.json["materials"][material];
-    let tex = m
-        .pointer("/normalTexture/index")
-        .or_else(|| m.pointer("/pbrMetallicRoughness/baseColorTexture/index"))
-        .and_then(|t| t.as_u64());
-    let sampler = tex.and_then(|t| scene.json.pointer(&format!("/textures/{t}/sampler"))).and_then(|s| s.as_u64());
-    let mode = sampler
-        .and_then(|s| scene.json.pointer(&format!("/samplers/{s}/wrapS")))
-        .and_then(|w| w.as_u64())
-        .unwrap_or(10497);
-    match mode {
+    let mats = scene.materials();
+    let m = mats.get(material);
+    let tex = m.and_then(|m| m.texture(Slot::Normal).or_else(|| m.texture(Slot::BaseColor)));
+    match scene.sampler_wrap_s(tex.and_then(|t| t.sampler)) {
         33071 => Wrap::Clamp,
         33648 => Wrap::Mirror,
         _ => Wrap::Repeat,
@@ -129,22 +121,7 @@ fn encode(img: image::DynamicImage) -> std::result::Result<Vec<u8>, String> {
 /// sampled like its base colour texture.
 pub fn attach(scene: &mut Scene, m: usize, png: &[u8], name: &str) {
     let img = scene.push_image(png, "image/png", Some(name));
-    let sampler = scene.json["materials"][m]
-        .pointer("/pbrMetallicRoughness/baseColorTexture/index")
-        .and_then(|t| t.as_u64())
-        .and_then(|t| scene.json.pointer(&format!("/textures/{t}/sampler")).cloned());
-    let mut tex = serde_json::json!({ "source": img });
-    if let Some(s) = sampler {
-        tex["sampler"] = s;
-    }
-    let textures = crate::scene::array_mut(&mut scene.json, "textures");
-    textures.push(tex);
-    let t = textures.len() - 1;
-    let mat = &mut scene.json["materials"][m];
-    let scale = mat.pointer("/normalTexture/scale").cloned();
-    let mut info = serde_json::json!({ "index": t });
-    if let Some(Value::Number(n)) = scale {
-        info["scale"] = Value::Number(n);
-    }
-    mat["normalTexture"] = info;
+    let sampler = scene.materials().get(m).and_then(|m| m.texture(Slot::BaseColor)).and_then(|t| t.sampler);
+    let t = scene.push_texture(img, sampler);
+    scene.set_normal_texture(m, t);
 }

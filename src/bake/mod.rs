@@ -119,14 +119,7 @@ fn ensure_material(scene: &mut Scene) {
 }
 
 fn material_names(scene: &Scene) -> Vec<Option<String>> {
-    scene
-        .json
-        .get("materials")
-        .and_then(|m| m.as_array())
-        .into_iter()
-        .flatten()
-        .map(|m| m.get("name").and_then(|n| n.as_str()).map(String::from))
-        .collect()
+    scene.materials().list.into_iter().map(|m| m.name).collect()
 }
 
 /// Decides which materials get which map, and attaches them.
@@ -139,9 +132,9 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
         })?),
         None => None,
     };
-    let wants_bump = |m: usize| {
-        scene.height_maps.iter().any(|h| h.material == m) || scene.json["materials"][m].get("normalTexture").is_some()
-    };
+    let mats = scene.materials();
+    let has_normal_texture = |m: usize| mats.get(m).and_then(|i| i.texture(scene::Slot::Normal)).is_some();
+    let wants_bump = |m: usize| scene.height_maps.iter().any(|h| h.material == m) || has_normal_texture(m);
     let targets: Vec<usize> = match (chosen, &job.map) {
         (Some(m), _) => vec![m],
         (None, MapSource::Scene) => (0..names.len()).collect(),
@@ -193,7 +186,7 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
                         file: Some(h.path.clone()),
                         convention: None,
                     });
-                } else if scene.json["materials"][m].get("normalTexture").is_some() {
+                } else if has_normal_texture(m) {
                     out.push(MaterialMap { material: m, name, source: "existing", file: None, convention: None });
                 }
             }

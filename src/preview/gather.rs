@@ -9,7 +9,8 @@
 
 use super::texture::{Sampler, Texture};
 use crate::error::Result;
-use crate::scene::{flat_normals, PrimRef, Scene};
+use crate::scene::material::{MaterialInfo, TextureUse};
+use crate::scene::{flat_normals, Materials, PrimRef, Scene, Slot, UvTransform};
 use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use serde_json::Value;
 use std::collections::HashMap;
@@ -22,6 +23,20 @@ pub struct TexRef {
     pub sampler: Sampler,
     /// Which UV set: 0 for `TEXCOORD_0`, 1 for `TEXCOORD_1`.
     pub texcoord: u32,
+    /// `KHR_texture_transform`, applied to the interpolated UV (it is affine, so that is the same
+    /// as interpolating transformed UVs).
+    pub transform: Option<UvTransform>,
+}
+
+impl TexRef {
+    /// The UV this texture is sampled at, from the interpolated UV sets.
+    pub fn uv(&self, sets: &[Vec2; 2]) -> Vec2 {
+        let uv = sets[self.texcoord as usize];
+        match &self.transform {
+            Some(t) => Vec2::from(t.apply(uv.to_array())),
+            None => uv,
+        }
+    }
 }
 
 /// The parts of a glTF material the seeds' shading model uses.
@@ -88,6 +103,7 @@ impl Prepared {
     pub fn with_frames(scene: &Scene, all_frames: bool) -> Result<Prepared> {
         let mut cx = Cx {
             scene,
+            mats: scene.materials(),
             all_frames,
             textures: HashMap::new(),
             materials: Vec::new(),
@@ -151,6 +167,7 @@ struct Local {
 
 struct Cx<'a> {
     scene: &'a Scene,
+    mats: Materials,
     all_frames: bool,
     textures: HashMap<(usize, bool), Arc<Texture>>,
     materials: Vec<Material>,
@@ -171,14 +188,18 @@ impl Cx<'_> {
             self.notes.push(format!("{where_}: no POSITION; not drawn"));
             return Ok(None);
         }
-        let uv_set = s.normal_texcoord(r).unwrap_or(0);
+        // The preview draws the primitive's own material: its need decides the frames.
+        let need = self.mats.default_of(s, r).and_then(|m| m.tangents()).cloned();
+        let uv_set = need.as_ref().map_or(0, |n| n.tex_coord);
         let uv_name = format!("TEXCOORD_{uv_set}");
         let tangents_ok = prim.attr("TANGENT").map(|t| t.format.components() == 4).unwrap_or(false);
-        let has_map = s.material_of(r).and_then(|m| m.get("normalTexture")).is_some();
+        let has_map = need.is_some();
         if !tangents_ok && (has_map || self.all_frames) && prim.attr(&uv_name).is_some() && prim.indices.len() >= 3 {
             prim.indices.truncate(prim.indices.len() / 3 * 3);
             // Exactly what `bumpbake tangents` would store, so the preview shows the tool's frames.
-            prim = crate::tangent::primitive_with_tangents(prim, uv_set, s.uv_v_up, &Default::default());
+            let transform = need.as_ref().and_then(|n| n.transform);
+            prim =
+                crate::tangent::primitive_with_uvs(prim, uv_set, transform.as_ref(), s.uv_v_up, &Default::default()).0;
             if has_map {
                 self.notes
                     .push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));
@@ -237,12 +258,12 @@ impl Cx<'_> {
     }
 
     fn material(&mut self, r: PrimRef) -> Result<usize> {
-        let idx = self.scene.prim_json(r).get("material").and_then(|m| m.as_u64()).map(|m| m as usize);
+        let idx = self.mats.default_of(self.scene, r).map(|m| m.index);
         if let Some(&i) = self.material_index.get(&idx) {
             return Ok(i);
         }
-        let m = match idx.and_then(|i| self.scene.json.pointer(&format!("/materials/{i}"))) {
-            Some(mj) => self.read_material(mj)?,
+        let m = match idx.and_then(|i| self.mats.get(i)).cloned() {
+            Some(info) => self.read_material(&info)?,
             None => Material::default(),
         };
         self.materials.push(m);
@@ -251,59 +272,58 @@ impl Cx<'_> {
         Ok(i)
     }
 
-    fn read_material(&mut self, mj: &Value) -> Result<Material> {
+    fn read_material(&mut self, info: &MaterialInfo) -> Result<Material> {
         let mut m = Material::default();
-        if let Some(f) = mj.pointer("/pbrMetallicRoughness/baseColorFactor").and_then(|f| f.as_array()) {
-            let c: Vec<f32> = f.iter().map(|x| x.as_f64().unwrap_or(1.0) as f32).collect();
-            if c.len() == 4 && c.iter().all(|x| x.is_finite()) {
-                m.base_color = Vec4::from_slice(&c);
-            }
+        if let Some(c) = info.base_color_factor.filter(|c| c.iter().all(|x| x.is_finite())) {
+            m.base_color = Vec4::from_array(c);
         }
-        if let Some(t) = mj.pointer("/pbrMetallicRoughness/baseColorTexture") {
+        if let Some(t) = info.texture(Slot::BaseColor) {
             m.base_texture = self.tex_ref(t, true)?;
         }
-        if let Some(t) = mj.get("normalTexture") {
+        if let Some(t) = info.texture(Slot::Normal) {
             m.normal_texture = self.tex_ref(t, false)?;
-            m.normal_scale = t.get("scale").and_then(|s| s.as_f64()).filter(|s| s.is_finite()).unwrap_or(1.0) as f32;
+            m.normal_scale = t.scale.unwrap_or(1.0) as f32;
         }
-        m.double_sided = mj.get("doubleSided").and_then(|d| d.as_bool()).unwrap_or(false);
+        m.double_sided = info.double_sided;
         Ok(m)
     }
 
-    fn tex_ref(&mut self, info: &Value, srgb: bool) -> Result<Option<TexRef>> {
+    fn tex_ref(&mut self, t: &TextureUse, srgb: bool) -> Result<Option<TexRef>> {
         let s = self.scene;
-        let Some(ti) = info.get("index").and_then(|i| i.as_u64()) else { return Ok(None) };
-        let tj =
-            s.json.pointer(&format!("/textures/{ti}")).ok_or_else(|| s.err(format!("texture {ti} does not exist")))?;
-        let Some(img) = tj.get("source").and_then(|i| i.as_u64()).map(|i| i as usize) else {
-            self.notes.push(format!("texture {ti} has no PNG/JPEG source; drawn without it"));
+        let ti = t.texture;
+        if !s.has_texture(ti) {
+            return Err(s.err(format!("texture {ti} does not exist")));
+        }
+        let Some(src) = t.images.first() else {
+            self.notes.push(format!("texture {ti} has no image source; drawn without it"));
             return Ok(None);
         };
-        let sampler = Sampler::from_json(
-            tj.get("sampler").and_then(|i| i.as_u64()).and_then(|i| s.json.pointer(&format!("/samplers/{i}"))),
-        );
-        let texcoord = info
-            .pointer("/extensions/KHR_texture_transform/texCoord")
-            .or_else(|| info.get("texCoord"))
-            .and_then(|t| t.as_u64())
-            .unwrap_or(0);
+        let img = src.image;
+        let sampler = Sampler::from_json(s.sampler_json(t.sampler));
+        let texcoord = t.tex_coord;
         if texcoord > 1 {
             self.notes.push(format!("texture {ti} reads TEXCOORD_{texcoord}; only sets 0 and 1 are drawn"));
             return Ok(None);
-        }
-        if info.pointer("/extensions/KHR_texture_transform").is_some() {
-            self.notes.push(format!("texture {ti}: KHR_texture_transform offset/scale/rotation is not applied"));
         }
         let texture = match self.textures.get(&(img, srgb)) {
             Some(t) => t.clone(),
             None => {
                 let bytes = image_bytes(s, img)?;
-                let t = Arc::new(Texture::decode(&bytes, srgb).map_err(|e| s.err(format!("image {img}: {e}")))?);
+                let t = match Texture::decode(&bytes, srgb) {
+                    Ok(t) => Arc::new(t),
+                    // Only an extension's image (no plain `source` to fall back on) may be in a
+                    // format the preview cannot read; say so and draw without it.
+                    Err(e) if src.via != "source" => {
+                        self.notes.push(format!("texture {ti}: image {img} ({}) not drawn: {e}", src.via));
+                        return Ok(None);
+                    }
+                    Err(e) => return Err(s.err(format!("image {img}: {e}"))),
+                };
                 self.textures.insert((img, srgb), t.clone());
                 t
             }
         };
-        Ok(Some(TexRef { texture, sampler, texcoord: texcoord as u32 }))
+        Ok(Some(TexRef { texture, sampler, texcoord, transform: t.transform }))
     }
 }
 

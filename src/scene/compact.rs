@@ -5,10 +5,10 @@
 //! alive while tangents are made. Anything that cannot be proved unreferenced (data an unknown
 //! extension might point at) is kept.
 
-use super::gltf_write::{accessor_refs, primitive_accessor_refs, renumber, uses_unknown_extension, view_refs};
+use super::refs::{accessor_refs, drop_unreferenced, primitive_accessor_refs, unknown_data_refs, view_refs};
 use super::{as_index, PrimRef, Scene};
 use serde_json::{json, Value};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::ops::Range;
 
 /// What happened to the scene's buffers before writing. The writer's report counts as if nothing
@@ -48,14 +48,14 @@ impl Scene {
     /// freeing the old bytes. Leaves the scene as it is when the document uses an extension this
     /// tool does not know or references something that does not exist (the writer decides then).
     pub fn compact(&mut self) {
-        if uses_unknown_extension(&self.json) {
+        if unknown_data_refs(&self.json) {
             return;
         }
         let Ok(accessors) = drop_unreferenced(&mut self.json, "accessors", false, accessor_refs) else { return };
-        self.ledger.accessors_dropped += accessors;
+        self.ledger.accessors_dropped += accessors.gone.len();
         let Ok(views) = drop_unreferenced(&mut self.json, "bufferViews", false, view_refs) else { return };
-        self.ledger.views_dropped += views;
-        if views == 0 {
+        self.ledger.views_dropped += views.gone.len();
+        if views.gone.is_empty() {
             return;
         }
         let last = self.buffers.last().map_or(0, |b| b.len());
@@ -77,7 +77,7 @@ impl Scene {
     /// [`set_primitive`](Self::set_primitive) puts each back, its attributes, indices and morph
     /// targets name no accessor; every other part of its JSON stays.
     pub fn release_primitives(&mut self, refs: &[PrimRef]) {
-        if refs.is_empty() || uses_unknown_extension(&self.json) {
+        if refs.is_empty() || unknown_data_refs(&self.json) {
             return;
         }
         for &r in refs {
@@ -94,31 +94,6 @@ impl Scene {
         }
         self.compact();
     }
-}
-
-/// A reference to an entry past the end of its list: (index, length of the list).
-pub(super) struct Dangling(pub usize, pub usize);
-
-/// Visits every reference to one kind of object (each index mutably, for renumbering) and
-/// returns the indices it saw.
-pub(super) type RefWalker = fn(&mut Value, &mut dyn FnMut(&mut usize)) -> BTreeSet<usize>;
-
-/// Drops the entries of `json[key]` that `refs` does not find (none with `keep_all`) and
-/// renumbers the references; returns how many went. Changes nothing when a reference dangles.
-pub(super) fn drop_unreferenced(
-    json: &mut Value,
-    key: &str,
-    keep_all: bool,
-    refs: RefWalker,
-) -> Result<usize, Dangling> {
-    let n = json.get(key).and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0);
-    let keep: BTreeSet<usize> = if keep_all { (0..n).collect() } else { refs(json, &mut |_| {}) };
-    if let Some(&i) = keep.iter().next_back().filter(|&&i| i >= n) {
-        return Err(Dangling(i, n));
-    }
-    let map = renumber(json, key, &keep);
-    refs(json, &mut |i| *i = map[*i].expect("kept entry"));
-    Ok(n - keep.len())
 }
 
 /// Where one buffer view's bytes come from, and where they land in the packed buffer.

@@ -4,40 +4,15 @@
 //! into one buffer, and renumbers the references. Anything it cannot prove unreferenced (data an
 //! unknown extension might point at) is kept.
 
-use super::compact::{drop_unreferenced, pack_views, set_offset, Dangling};
+use super::compact::{pack_views, set_offset};
+use super::refs::{accessor_refs, drop_unreferenced, unknown_data_refs, view_refs, Dangling};
 use super::{uri, Scene};
 use crate::error::{Error, Result};
 use crate::output::Outputs;
 use base64::Engine as _;
 use serde_json::{json, Value};
 use std::borrow::Cow;
-use std::collections::BTreeSet;
 use std::path::Path;
-
-/// Extensions known not to reference accessors or buffer views (or whose references we follow).
-const KNOWN_EXTENSIONS: &[&str] = &[
-    "KHR_texture_transform",
-    "KHR_lights_punctual",
-    "KHR_materials_clearcoat",
-    "KHR_materials_emissive_strength",
-    "KHR_materials_ior",
-    "KHR_materials_iridescence",
-    "KHR_materials_sheen",
-    "KHR_materials_specular",
-    "KHR_materials_transmission",
-    "KHR_materials_unlit",
-    "KHR_materials_variants",
-    "KHR_materials_volume",
-    "KHR_materials_anisotropy",
-    "KHR_materials_dispersion",
-    "KHR_materials_pbrSpecularGlossiness",
-    "KHR_mesh_quantization",
-    "KHR_texture_basisu",
-    "EXT_texture_webp",
-    "EXT_mesh_gpu_instancing",
-    "KHR_xmp_json_ld",
-    "KHR_animation_pointer",
-];
 
 #[derive(Debug, Clone, Default)]
 pub struct WriteOptions {
@@ -90,7 +65,7 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
     let mut json = scene.json.clone();
     let held: usize = scene.buffers.iter().map(|b| b.len()).sum();
     let mut stats = WriteStats { buffer_bytes_in: held + scene.ledger.bytes_unheld, ..Default::default() };
-    let keep_all = uses_unknown_extension(&json);
+    let keep_all = unknown_data_refs(&json);
     let mut bin = Bin::default();
     let mut files = Outputs::new();
     let out_dir = out.parent().map(|p| p.to_path_buf()).unwrap_or_default();
@@ -101,7 +76,7 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
     // Accessors.
     let dropped =
         drop_unreferenced(&mut json, "accessors", keep_all, accessor_refs).map_err(|d| dangling("accessor", d))?;
-    stats.accessors_dropped = dropped + scene.ledger.accessors_dropped;
+    stats.accessors_dropped = dropped.gone.len() + scene.ledger.accessors_dropped;
 
     // Images: embedded, copied or written out, before buffer views are renumbered.
     let images = json.get("images").and_then(|i| i.as_array()).cloned().unwrap_or_default();
@@ -175,7 +150,7 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
     // Buffer views: keep what kept accessors, images and compressed primitives use; repack.
     let dropped =
         drop_unreferenced(&mut json, "bufferViews", keep_all, view_refs).map_err(|d| dangling("bufferView", d))?;
-    stats.buffer_views_dropped = dropped + scene.ledger.views_dropped;
+    stats.buffer_views_dropped = dropped.gone.len() + scene.ledger.views_dropped;
     for p in pack_views(&mut json, &scene.buffers).ok_or_else(|| scene.err("bufferView runs past its buffer"))? {
         bin.pad4();
         debug_assert_eq!(bin.len, p.at);
@@ -342,127 +317,5 @@ fn sniff_mime(bytes: &[u8], uri: &str) -> String {
         "image/jpeg".into()
     } else {
         "image/png".into()
-    }
-}
-
-pub(super) fn uses_unknown_extension(json: &Value) -> bool {
-    json.get("extensionsUsed")
-        .and_then(|e| e.as_array())
-        .map(|list| list.iter().any(|e| !KNOWN_EXTENSIONS.contains(&e.as_str().unwrap_or(""))))
-        .unwrap_or(false)
-}
-
-/// Visits every accessor reference; returns the set of indices seen.
-pub(super) fn accessor_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
-    let mut seen = BTreeSet::new();
-    let mut visit = |v: &mut Value| visit_index(v, &mut seen, f);
-    for mesh in arr_mut(json, "meshes") {
-        for p in arr_mut(mesh, "primitives") {
-            primitive_accessor_refs(p, &mut visit);
-        }
-    }
-    for skin in arr_mut(json, "skins") {
-        if let Some(i) = skin.get_mut("inverseBindMatrices") {
-            visit(i);
-        }
-    }
-    for anim in arr_mut(json, "animations") {
-        for s in arr_mut(anim, "samplers") {
-            for key in ["input", "output"] {
-                if let Some(i) = s.get_mut(key) {
-                    visit(i);
-                }
-            }
-        }
-    }
-    for node in arr_mut(json, "nodes") {
-        let inst = node.pointer_mut("/extensions/EXT_mesh_gpu_instancing/attributes");
-        for a in obj_values_mut(inst) {
-            visit(a);
-        }
-    }
-    seen
-}
-
-/// Visits the accessor references of one primitive: attributes, indices, morph targets.
-pub(super) fn primitive_accessor_refs(p: &mut Value, visit: &mut dyn FnMut(&mut Value)) {
-    for a in obj_values_mut(p.get_mut("attributes")) {
-        visit(a);
-    }
-    if let Some(i) = p.get_mut("indices") {
-        visit(i);
-    }
-    for t in arr_mut(p, "targets") {
-        for a in obj_values_mut(Some(t)) {
-            visit(a);
-        }
-    }
-}
-
-/// Visits every buffer-view reference; returns the set of indices seen.
-pub(super) fn view_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
-    let mut seen = BTreeSet::new();
-    let mut visit = |v: &mut Value| visit_index(v, &mut seen, f);
-    for a in arr_mut(json, "accessors") {
-        if let Some(v) = a.get_mut("bufferView") {
-            visit(v);
-        }
-        for p in ["/sparse/indices/bufferView", "/sparse/values/bufferView"] {
-            if let Some(v) = a.pointer_mut(p) {
-                visit(v);
-            }
-        }
-    }
-    for img in arr_mut(json, "images") {
-        if let Some(v) = img.get_mut("bufferView") {
-            visit(v);
-        }
-    }
-    for mesh in arr_mut(json, "meshes") {
-        for p in arr_mut(mesh, "primitives") {
-            if let Some(v) = p.pointer_mut("/extensions/KHR_draco_mesh_compression/bufferView") {
-                visit(v);
-            }
-        }
-    }
-    seen
-}
-
-fn visit_index(v: &mut Value, seen: &mut BTreeSet<usize>, f: &mut dyn FnMut(&mut usize)) {
-    if let Some(mut i) = v.as_u64().map(|i| i as usize) {
-        seen.insert(i);
-        f(&mut i);
-        *v = json!(i);
-    }
-}
-
-/// Keeps the listed entries of `json[key]`; returns old index -> new index.
-pub(super) fn renumber(json: &mut Value, key: &str, keep: &BTreeSet<usize>) -> Vec<Option<usize>> {
-    let list = json.get(key).and_then(|a| a.as_array()).cloned().unwrap_or_default();
-    let mut map = vec![None; list.len().max(keep.iter().next_back().map(|m| m + 1).unwrap_or(0))];
-    let mut kept = Vec::new();
-    for (i, item) in list.into_iter().enumerate() {
-        if keep.contains(&i) {
-            map[i] = Some(kept.len());
-            kept.push(item);
-        }
-    }
-    if json.get(key).is_some() {
-        json[key] = Value::Array(kept);
-    }
-    map
-}
-
-fn arr_mut<'a>(v: &'a mut Value, key: &str) -> std::slice::IterMut<'a, Value> {
-    match v.get_mut(key).and_then(|a| a.as_array_mut()) {
-        Some(a) => a.iter_mut(),
-        None => [].iter_mut(),
-    }
-}
-
-fn obj_values_mut(v: Option<&mut Value>) -> Vec<&mut Value> {
-    match v.and_then(|v| v.as_object_mut()) {
-        Some(o) => o.values_mut().collect(),
-        None => Vec::new(),
     }
 }

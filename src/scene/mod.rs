@@ -11,12 +11,15 @@ mod compact;
 mod gltf_read;
 mod gltf_write;
 pub mod image_limits;
+pub mod material;
 mod obj;
+pub mod refs;
 pub mod uri;
 pub mod weld;
 
 pub use accessor::{Format, Stream};
 pub use gltf_write::{write, WriteOptions, WriteStats};
+pub use material::{Materials, PrimNeed, Slot, TangentNeed, UvTransform};
 pub use obj::{flat_normals, smooth_normals};
 
 use crate::error::{Error, Result};
@@ -247,12 +250,10 @@ impl Scene {
         self.array("materials").get(m)
     }
 
-    /// The UV set the primitive's normal texture reads, if its material has one
-    /// (`KHR_texture_transform` may override `texCoord`).
+    /// The UV set the primitive's own material's normal texture reads, if it has one
+    /// (see [`Scene::materials`] for everything else a material reads and needs).
     pub fn normal_texcoord(&self, r: PrimRef) -> Option<u32> {
-        let nt = self.material_of(r)?.get("normalTexture")?;
-        let over = nt.pointer("/extensions/KHR_texture_transform/texCoord").and_then(|v| v.as_u64());
-        Some(over.or_else(|| nt.get("texCoord").and_then(|v| v.as_u64())).unwrap_or(0) as u32)
+        self.materials().default_of(self, r)?.texture(Slot::Normal).map(|t| t.tex_coord)
     }
 
     /// Reads a primitive's streams, indices and morph targets.

@@ -1,12 +1,14 @@
 //! Which primitives of a scene get tangents, and putting them there.
 //!
-//! Like gltfpack's `needs_tangents`, the material decides: a triangle primitive whose material has
-//! a `normalTexture` gets frames from the UV set that texture reads. Everything else is skipped
-//! with a reason the report names.
+//! Like gltfpack's `needsTangents`, the material decides: a triangle primitive gets frames when a
+//! material it can show (its own, or one a `KHR_materials_variants` mapping switches to) has a
+//! normal texture, a clearcoat normal texture or anisotropy, from the UVs that texture reads,
+//! transformed as `KHR_texture_transform` says. Everything else is skipped with a reason the report
+//! names.
 
-use super::{primitive_with_stats, FrameStats, Options};
+use super::{primitive_with_uvs, FrameStats, Options};
 use crate::error::Result;
-use crate::scene::{PrimRef, Primitive, Scene};
+use crate::scene::{Materials, PrimNeed, PrimRef, Primitive, Scene, UvTransform};
 use rayon::prelude::*;
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -28,11 +30,28 @@ pub struct PrimReport {
     /// Why it was skipped, kept or regenerated.
     pub reason: Option<String>,
     pub uv_set: Option<u32>,
+    /// What needs the tangents: `normal texture reads TEXCOORD_0`, `KHR_materials_anisotropy of
+    /// variant material 2 needs tangents from TEXCOORD_0`...
+    pub needed_by: Option<String>,
     pub stats: Option<FrameStats>,
 }
 
-/// Why a primitive needs no tangents, or the UV set it needs them from.
-pub fn needs_tangents(scene: &Scene, r: PrimRef, all: bool) -> std::result::Result<u32, String> {
+/// The UVs a primitive's tangents follow.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TangentUvs {
+    pub set: u32,
+    pub transform: Option<UvTransform>,
+    /// What needs them; None with `--all` where no material does.
+    pub need: Option<PrimNeed>,
+}
+
+/// Why a primitive needs no tangents, or the UVs it needs them from.
+pub fn needs_tangents(
+    scene: &Scene,
+    mats: &Materials,
+    r: PrimRef,
+    all: bool,
+) -> std::result::Result<TangentUvs, String> {
     let pj = scene.prim_json(r);
     let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
     if !(4..=6).contains(&mode) {
@@ -45,34 +64,38 @@ pub fn needs_tangents(scene: &Scene, r: PrimRef, all: bool) -> std::result::Resu
     if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
         return Err("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".into());
     }
-    let set = match (scene.material_of(r), scene.normal_texcoord(r)) {
-        (_, Some(set)) => set,
-        (_, None) if all => 0,
-        (None, None) => return Err("no material".into()),
-        (Some(_), None) => return Err("material has no normal texture".into()),
+    let uvs = match mats.tangent_need(scene, r) {
+        Some(need) => TangentUvs { set: need.need.tex_coord, transform: need.need.transform, need: Some(need) },
+        None if all => TangentUvs { set: 0, transform: None, need: None },
+        None if mats.default_of(scene, r).is_none() => return Err("no material".into()),
+        None => return Err("material has no normal texture".into()),
     };
-    if pj.pointer(&format!("/attributes/TEXCOORD_{set}")).is_none() {
-        return Err(format!("no UVs (TEXCOORD_{set}, which the normal texture reads)"));
+    if pj.pointer(&format!("/attributes/TEXCOORD_{}", uvs.set)).is_none() {
+        let what =
+            uvs.need.as_ref().map(|n| n.describe()).unwrap_or_else(|| format!("TEXCOORD_{} --all reads", uvs.set));
+        return Err(format!("no UVs (the {what}, which the primitive does not have)"));
     }
-    Ok(set)
+    Ok(uvs)
 }
 
 /// Gives every primitive that needs them MikkTSpace tangents; returns a report per primitive.
 pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> {
     let mut reports = Vec::new();
-    let mut work: Vec<(PrimRef, u32, Primitive, Option<String>)> = Vec::new();
+    let mut work: Vec<(PrimRef, TangentUvs, Primitive)> = Vec::new();
+    let mats = scene.materials();
     for r in scene.primitives() {
-        let report = |action, reason: Option<String>, uv_set| PrimReport {
+        let report = |action, reason: Option<String>, uvs: Option<&TangentUvs>| PrimReport {
             mesh: r.mesh,
             primitive: r.primitive,
             action,
             reason,
-            uv_set,
+            uv_set: uvs.map(|u| u.set),
+            needed_by: uvs.and_then(|u| u.need.as_ref()).map(|n| n.describe()),
             stats: None,
         };
-        match needs_tangents(scene, r, opts.all) {
+        match needs_tangents(scene, &mats, r, opts.all) {
             Err(why) => reports.push(report("skipped", Some(why), None)),
-            Ok(set) => {
+            Ok(uvs) => {
                 let p = to_triangle_list(scene.primitive(r)?);
                 let why = match p.attr("TANGENT") {
                     Some(t) if !opts.overwrite => match invalid_tangents(t) {
@@ -80,7 +103,7 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
                             reports.push(report(
                                 "kept",
                                 Some("valid tangents already present (--overwrite replaces them)".into()),
-                                Some(set),
+                                Some(&uvs),
                             ));
                             continue;
                         }
@@ -89,8 +112,10 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
                     Some(_) => Some("existing tangents replaced (--overwrite)".into()),
                     None => None,
                 };
-                reports.push(report("generated", why.clone(), Some(set)));
-                work.push((r, set, p, why));
+                let conflicts = uvs.need.iter().flat_map(|n| n.conflicts.iter().cloned());
+                let why = why.into_iter().chain(conflicts).collect::<Vec<_>>();
+                reports.push(report("generated", (!why.is_empty()).then(|| why.join("; ")), Some(&uvs)));
+                work.push((r, uvs, p));
             }
         }
     }
@@ -98,8 +123,10 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
     let refs: Vec<PrimRef> = work.iter().map(|w| w.0).collect();
     scene.release_primitives(&refs);
     let v_up = scene.uv_v_up;
-    let done: Vec<(Primitive, FrameStats)> =
-        work.into_par_iter().map(|(_, set, p, _)| primitive_with_stats(p, set, v_up, &opts.frames)).collect();
+    let done: Vec<(Primitive, FrameStats)> = work
+        .into_par_iter()
+        .map(|(_, uvs, p)| primitive_with_uvs(p, uvs.set, uvs.transform.as_ref(), v_up, &opts.frames))
+        .collect();
     for (r, (p, stats)) in refs.iter().zip(done) {
         scene.put_primitive(*r, p);
         if let Some(rep) = reports.iter_mut().find(|x| x.mesh == r.mesh && x.primitive == r.primitive) {

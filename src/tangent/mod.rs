@@ -11,7 +11,7 @@ pub mod frames;
 pub mod mikk;
 
 use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
-use crate::scene::{flat_normals, Primitive};
+use crate::scene::{flat_normals, Primitive, UvTransform};
 use fallback::FallbackCounts;
 use glam::Vec3;
 
@@ -56,10 +56,22 @@ pub fn primitive_with_tangents(p: Primitive, uv_set: u32, uv_v_up: bool, opts: &
 /// [`primitive_with_tangents`], with what it did. Takes the primitive by value so that each of
 /// its streams can be freed as soon as the output's copy of it is made.
 pub fn primitive_with_stats(p: Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
+    primitive_with_uvs(p, uv_set, None, uv_v_up, opts)
+}
+
+/// [`primitive_with_stats`] for a texture read through `KHR_texture_transform`: the frames follow
+/// the transformed UVs (the ones the renderer samples with), while the stored UVs stay as they are.
+pub fn primitive_with_uvs(
+    p: Primitive,
+    uv_set: u32,
+    transform: Option<&UvTransform>,
+    uv_v_up: bool,
+    opts: &Options,
+) -> (Primitive, FrameStats) {
     let vertices_in = p.vertex_count();
     let triangles = p.indices.len() / 3;
     let generated_normals = p.attr("NORMAL").is_none();
-    let (plan, fallback) = split_plan(&p, uv_set, uv_v_up, opts);
+    let (plan, fallback) = split_plan(&p, uv_set, transform, uv_v_up, opts);
     let mut out = plan.apply(p);
     out.mode = 4;
     crate::report::mem_mark("split");
@@ -69,13 +81,22 @@ pub fn primitive_with_stats(p: Primitive, uv_set: u32, uv_v_up: bool, opts: &Opt
 
 /// Frames for every corner of `p`, repaired, and the vertices and streams they make: everything
 /// that reads the frames, which are freed on return.
-fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (SplitPlan, FallbackCounts) {
+fn split_plan(
+    p: &Primitive,
+    uv_set: u32,
+    transform: Option<&UvTransform>,
+    uv_v_up: bool,
+    opts: &Options,
+) -> (SplitPlan, FallbackCounts) {
     let uv_name = format!("TEXCOORD_{uv_set}");
     let n_vertices = p.vertex_count();
     // Borrowed from the streams where possible. Without POSITION (callers skip such primitives)
     // the surface is a point.
     let positions = p.attr("POSITION").map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 3]; n_vertices].into());
-    let uvs = p.attr(&uv_name).map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
+    let mut uvs = p.attr(&uv_name).map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
+    if let Some(t) = transform {
+        uvs = uvs.iter().map(|&uv| t.apply(uv)).collect::<Vec<_>>().into();
+    }
 
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.

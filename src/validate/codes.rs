@@ -50,7 +50,7 @@ macro_rules! codes {
 codes! {
     /// A normal texture needs a tangent space and the primitive has no TANGENT.
     TANGENT_MISSING = Warning, "run `bumpbake tangents IN -o OUT`: renderers that derive tangents themselves (many use screen-space derivatives) do not reproduce the frames the map was baked against";
-    /// TANGENT is present but no normal texture reads it.
+    /// TANGENT is present but nothing reads it (no normal, clearcoat normal or anisotropy texture).
     TANGENT_UNUSED = Info, "nothing uses these tangents: leave them out to save memory";
     /// TANGENT without NORMAL: the glTF spec says to ignore the tangents.
     TANGENT_WITHOUT_NORMAL = Warning, "export NORMAL too; without it clients compute flat normals and must ignore TANGENT";

@@ -4,7 +4,7 @@
 use super::frames::{self, Explained, PrimData};
 use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
 use crate::error::Result;
-use crate::scene::{PrimRef, Scene};
+use crate::scene::{Materials, PrimRef, Scene};
 use crate::tangent::apply::to_triangle_list;
 use rayon::prelude::*;
 use serde_json::Value;
@@ -13,6 +13,7 @@ use std::collections::BTreeMap;
 pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     // Reading is cheap and may fail (exit 2); checking is the expensive part and runs in parallel.
     let mut subjects = Vec::new();
+    let mats = scene.materials();
     for r in scene.primitives() {
         let mut s = Subject::new("primitive", prim_name(scene, r));
         s.mesh = Some(r.mesh);
@@ -47,24 +48,32 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             subjects.push((s, None));
             continue;
         }
-        let map_set = scene.normal_texcoord(r);
-        let uv_name = format!("TEXCOORD_{}", map_set.unwrap_or(0));
+        // The UVs the renderer samples the map with: the texture transform's output, which is
+        // what the tangent must follow.
+        let need = mats.tangent_need(scene, r);
+        let uv_name = format!("TEXCOORD_{}", need.as_ref().map_or(0, |n| n.need.tex_coord));
+        let transform = need.as_ref().and_then(|n| n.need.transform);
+        let uvs = p.attr(&uv_name).map(|s| match transform {
+            Some(t) => s.to_f32::<2>().into_iter().map(|uv| t.apply(uv)).collect(),
+            None => s.to_f32::<2>(),
+        });
         let d = PrimData {
             positions: p.positions(),
             normals: p.attr("NORMAL").map(|s| s.to_f32::<3>()),
-            uvs: p.attr(&uv_name).map(|s| s.to_f32::<2>()),
+            uvs,
             tangents: p.attr("TANGENT").map(|s| s.to_f32::<4>()),
             indices: p.indices,
             uv_v_up: scene.uv_v_up,
         };
-        subjects.push((s, Some((d, map_set.is_some()))));
+        let wanted_by = need.map(|n| n.describe());
+        subjects.push((s, Some((d, wanted_by))));
     }
     let max_angle = opts.max_angle_deg;
     let mut done: Vec<Subject> = subjects
         .into_par_iter()
         .map(|(mut s, data)| {
-            if let Some((d, uses_map)) = data {
-                check_primitive(&d, uses_map, max_angle, scene.uv_v_up, &mut s);
+            if let Some((d, wanted_by)) = data {
+                check_primitive(&d, wanted_by.as_deref(), max_angle, scene.uv_v_up, &mut s);
             }
             s
         })
@@ -72,7 +81,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     if let Some(s) = check_nodes(scene) {
         done.push(s);
     }
-    done.extend(check_images(scene));
+    done.extend(check_images(scene, &mats));
     Ok(done)
 }
 
@@ -84,8 +93,10 @@ fn prim_name(scene: &Scene, r: PrimRef) -> String {
 }
 
 /// Every check of one primitive, in the order that lets later checks skip what earlier ones
-/// explained.
-fn check_primitive(d: &PrimData, uses_map: bool, max_angle_deg: f64, from_obj: bool, s: &mut Subject) {
+/// explained. `wanted_by` says what needs tangents (a normal, clearcoat normal or anisotropy
+/// texture of a material the primitive can show), if anything does.
+fn check_primitive(d: &PrimData, wanted_by: Option<&str>, max_angle_deg: f64, from_obj: bool, s: &mut Subject) {
+    let uses_map = wanted_by.is_some();
     let has_t = d.tangents.is_some();
     let has_n = d.normals.is_some();
     // OBJ cannot store tangents: the renderer that loads it always makes its own.
@@ -98,7 +109,7 @@ fn check_primitive(d: &PrimData, uses_map: bool, max_angle_deg: f64, from_obj: b
                     1,
                     1,
                     "primitives",
-                    "the material has a normal texture, but the primitive has no TANGENT",
+                    format!("tangents are needed ({}), but the primitive has no TANGENT", wanted_by.unwrap_or("")),
                 )
             }),
         );
@@ -112,7 +123,7 @@ fn check_primitive(d: &PrimData, uses_map: bool, max_angle_deg: f64, from_obj: b
                     1,
                     1,
                     "primitives",
-                    "TANGENT is present but no normal texture reads it",
+                    "TANGENT is present but nothing reads it (no normal, clearcoat normal or anisotropy texture)",
                 )
             }),
         );
@@ -234,21 +245,21 @@ fn local_det_sign(node: &Value) -> i8 {
     }
 }
 
-/// Each image some material uses as its normal texture, checked once.
-fn check_images(scene: &Scene) -> Vec<Subject> {
-    let mut users: BTreeMap<usize, Vec<String>> = BTreeMap::new();
-    for (m, mat) in scene.json.get("materials").and_then(|m| m.as_array()).into_iter().flatten().enumerate() {
-        let Some(tex) = mat.pointer("/normalTexture/index").and_then(|i| i.as_u64()) else { continue };
-        let Some(img) = scene.json.pointer(&format!("/textures/{tex}/source")).and_then(|i| i.as_u64()) else {
-            continue;
-        };
-        let name = mat
-            .get("name")
-            .and_then(|n| n.as_str())
-            .map(|n| format!("material {m} ('{n}')"))
-            .unwrap_or(format!("material {m}"));
-        users.entry(img as usize).or_default().push(name);
-    }
+/// Each image some material uses as its normal texture (or clearcoat normal texture), checked once.
+fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
+    let users: BTreeMap<usize, Vec<String>> = mats
+        .normal_images()
+        .into_iter()
+        .map(|(i, users)| {
+            let mut names: Vec<String> = Vec::new();
+            for (m, _) in users {
+                if !names.contains(&m.label()) {
+                    names.push(m.label());
+                }
+            }
+            (i, names)
+        })
+        .collect();
     users
         .into_iter()
         .map(|(i, mats)| {
@@ -261,7 +272,7 @@ fn check_images(scene: &Scene) -> Vec<Subject> {
                 .unwrap_or(format!("image {i}"));
             let mut s = Subject::new("image", label);
             s.image = Some(i);
-            let wanted_by = format!("{} (glTF normalTexture)", mats.join(", "));
+            let wanted_by = format!("{} (as a normal map)", mats.join(", "));
             match image_bytes(scene, &img_json)
                 .and_then(|b| image::load_from_memory(&b).map_err(|e| format!("cannot decode: {e}")))
             {
