@@ -10,7 +10,8 @@ use std::path::PathBuf;
 #[command(after_help = "Examples:
   bumpbake validate model.glb
   bumpbake validate assets/*.gltf --strict --format junit > validate.xml
-  bumpbake validate scene.gltf normal.png --format github --allow TANGENT_UNUSED --max-angle-deg 2")]
+  bumpbake validate scene.gltf normal.png --format github --allow TANGENT_UNUSED --max-angle-deg 2
+  bumpbake validate assets/*.glb --format sarif > bumpbake.sarif")]
 pub struct Args {
     /// Inputs: .gltf, .glb, .obj, or normal-map images (.png, .tif, .exr).
     #[arg(required_unless_present = "list_codes")]
@@ -53,6 +54,7 @@ pub enum Format {
     Json,
     Junit,
     Github,
+    Sarif,
 }
 
 fn codes(list: &[String]) -> Result<Vec<Code>> {
@@ -93,6 +95,10 @@ pub fn run(a: Args) -> Result<u8> {
         Format::Json => println!("{}", report::json(&rep)),
         Format::Junit => print!("{}", report::junit(&rep)),
         Format::Github => print!("{}", report::github(&rep)),
+        Format::Sarif => {
+            let unusable: Vec<String> = failed.iter().map(|e| e.to_string()).collect();
+            println!("{}", report::sarif(&rep, &unusable))
+        }
     }
     if !a.quiet {
         eprint!("{}", report::text(&rep));

@@ -1,8 +1,11 @@
 //! The report in the formats people and CI systems read: a human summary, JSON (schema in
 //! `docs/validate.md`), JUnit XML (one testcase per subject and check, which CI systems display
-//! natively) and GitHub workflow annotations.
+//! natively), GitHub workflow annotations, and SARIF 2.1.0 (`sarif.rs`).
+
+mod sarif;
 
 use super::{Finding, Report, Severity, Subject};
+pub use sarif::sarif;
 use serde_json::json;
 
 /// The JSON schema identifier; bumped only on incompatible changes.

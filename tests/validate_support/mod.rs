@@ -6,16 +6,127 @@ use crate::common::*;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
-/// Runs `validate --format json` and returns the exit code and the parsed report.
+/// Runs `validate --format json` and returns the exit code and the parsed report. The same
+/// command with `--format sarif` runs too: its log must pass the SARIF 2.1.0 schema and carry the
+/// same findings ([`assert_sarif_matches`]), so every file these tests validate checks both.
 pub fn validate(args: &[&str]) -> (i32, Value) {
-    let mut a = vec!["validate", "--format", "json", "-q"];
+    let (code, v) = validate_as("json", args);
+    let (sarif_code, log) = validate_as("sarif", args);
+    assert_eq!(sarif_code, code, "same exit code with --format sarif: {args:?}");
+    assert_sarif_matches(&log, &v);
+    (code, v)
+}
+
+/// Runs `validate --format FORMAT -q ARGS` and parses stdout as JSON.
+pub fn validate_as(format: &str, args: &[&str]) -> (i32, Value) {
+    let mut a = vec!["validate", "--format", format, "-q"];
     a.extend_from_slice(args);
     let out = run(&a);
     let code = out.status.code().expect("exit code");
     let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
-        panic!("json ({e}): {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+        panic!("{format} ({e}): {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
     });
     (code, v)
+}
+
+/// The SARIF 2.1.0 schema (OASIS errata 01, vendored in fixtures/sarif), compiled once.
+pub fn sarif_schema() -> &'static jsonschema::Validator {
+    static V: std::sync::OnceLock<jsonschema::Validator> = std::sync::OnceLock::new();
+    V.get_or_init(|| {
+        let text = std::fs::read_to_string(fixture("sarif/sarif-schema-2.1.0.json")).unwrap();
+        let schema: Value = serde_json::from_str(&text).unwrap();
+        jsonschema::validator_for(&schema).expect("the SARIF schema compiles")
+    })
+}
+
+/// Asserts that a SARIF log passes the schema, listing every violation.
+pub fn assert_sarif_valid(log: &Value) {
+    let errors: Vec<String> =
+        sarif_schema().iter_errors(log).map(|e| format!("{} at {}", e, e.instance_path())).collect();
+    assert!(errors.is_empty(), "SARIF schema violations:\n{}\n{log:#}", errors.join("\n"));
+}
+
+/// Undoes the percent-escapes of a URI.
+pub fn unescape_uri(u: &str) -> String {
+    let b = u.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            out.push(u8::from_str_radix(&u[i + 1..i + 3], 16).expect("hex escape"));
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).unwrap()
+}
+
+/// The SARIF level a JSON severity maps to.
+pub fn sarif_level(severity: &str) -> &'static str {
+    match severity {
+        "error" => "error",
+        "warning" => "warning",
+        "info" => "note",
+        other => panic!("unknown severity {other}"),
+    }
+}
+
+/// Asserts that a SARIF log is valid and carries exactly the JSON report's findings, in order:
+/// rule, level, message, the file, and the glTF element as a logical location.
+pub fn assert_sarif_matches(log: &Value, report: &Value) {
+    assert_sarif_valid(log);
+    assert_eq!(log["version"], "2.1.0");
+    let run = &log["runs"][0];
+    let rules = run["tool"]["driver"]["rules"].as_array().unwrap();
+    let artifacts = run["artifacts"].as_array().unwrap();
+    let files = report["files"].as_array().unwrap();
+    assert_eq!(artifacts.len(), files.len(), "one artifact per file: {log:#}");
+    for (a, f) in artifacts.iter().zip(files) {
+        let path = f["path"].as_str().unwrap();
+        let uri = unescape_uri(a["location"]["uri"].as_str().unwrap());
+        let expected = if path.starts_with('/') { format!("file://{path}") } else { path.to_string() };
+        assert_eq!(uri, expected);
+    }
+    let mut expected = Vec::new();
+    for (fi, f) in files.iter().enumerate() {
+        for s in f["subjects"].as_array().unwrap() {
+            for x in s["findings"].as_array().unwrap() {
+                expected.push((fi, s, x));
+            }
+        }
+    }
+    let results = run["results"].as_array().unwrap();
+    assert_eq!(results.len(), expected.len(), "one result per finding: {log:#}\n{report:#}");
+    for (res, (fi, sub, x)) in results.iter().zip(expected) {
+        let code = x["code"].as_str().unwrap();
+        assert_eq!(res["ruleId"], code);
+        assert_eq!(rules[res["ruleIndex"].as_u64().unwrap() as usize]["id"], code, "ruleIndex points at the rule");
+        assert_eq!(res["level"], sarif_level(x["severity"].as_str().unwrap()), "{res:#}");
+        let text = res["message"]["text"].as_str().unwrap();
+        assert!(text.contains(x["message"].as_str().unwrap()) && text.contains(x["hint"].as_str().unwrap()), "{text}");
+        assert_eq!((&res["properties"]["count"], &res["properties"]["total"]), (&x["count"], &x["total"]));
+        let loc = &res["locations"][0];
+        assert_eq!(loc["physicalLocation"]["artifactLocation"]["index"], fi);
+        assert_eq!(loc["physicalLocation"]["artifactLocation"]["uri"], artifacts[fi]["location"]["uri"]);
+        let logical: Vec<&str> = loc["logicalLocations"]
+            .as_array()
+            .map(|l| l.iter().map(|l| l["fullyQualifiedName"].as_str().unwrap()).collect())
+            .unwrap_or_default();
+        let want: Vec<String> = match (sub["mesh"].as_u64(), sub["primitive"].as_u64(), sub["image"].as_u64()) {
+            (Some(m), Some(p), _) => vec![format!("meshes/{m}/primitives/{p}")],
+            (_, _, Some(i)) => vec![format!("images/{i}")],
+            _ => x["examples"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|e| e["kind"] == "node")
+                .map(|e| format!("nodes/{}", e["index"]))
+                .collect(),
+        };
+        assert_eq!(logical, want, "{res:#}");
+    }
 }
 
 /// Every finding as (code, severity).
