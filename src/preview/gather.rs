@@ -178,7 +178,8 @@ impl Cx<'_> {
         if !tangents_ok && (has_map || self.all_frames) && prim.attr(&uv_name).is_some() && prim.indices.len() >= 3 {
             prim.indices.truncate(prim.indices.len() / 3 * 3);
             // Exactly what `bumpbake tangents` would store, so the preview shows the tool's frames.
-            prim = crate::tangent::primitive_with_tangents(prim, uv_set, s.uv_v_up, &Default::default());
+            let opts = crate::tangent::Options { uv_transform: s.normal_uv_transform(r), ..Default::default() };
+            prim = crate::tangent::primitive_with_tangents(prim, uv_set, s.uv_v_up, &opts);
             if has_map {
                 self.notes
                     .push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));

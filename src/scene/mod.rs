@@ -8,9 +8,12 @@
 
 pub mod accessor;
 mod compact;
+pub mod dequant;
+pub mod draco;
 mod gltf_read;
 mod gltf_write;
 pub mod image_limits;
+mod meshopt;
 mod obj;
 pub mod uri;
 pub mod weld;
@@ -255,8 +258,17 @@ impl Scene {
         Some(over.or_else(|| nt.get("texCoord").and_then(|v| v.as_u64())).unwrap_or(0) as u32)
     }
 
+    /// The transform the primitive's normal texture applies to its UVs (KHR_texture_transform),
+    /// if any: MikkTSpace must see the UVs the normal map is sampled with.
+    pub fn normal_uv_transform(&self, r: PrimRef) -> Option<dequant::UvTransform> {
+        dequant::UvTransform::from_texture_info(self.material_of(r)?.get("normalTexture")?)
+    }
+
     /// Reads a primitive's streams, indices and morph targets.
     pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
+        if let Some(why) = draco::why_unreadable(self, r) {
+            return Err(self.err(why));
+        }
         let pj = self.prim_json(r);
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
         let attrs = pj
@@ -391,7 +403,17 @@ impl Scene {
     /// [`push_accessor`](Self::push_accessor) that moves the stream's bytes into a buffer of
     /// their own: no copy, and no growing buffer to reallocate. The writer packs all buffers
     /// into one anyway.
-    pub fn push_stream(&mut self, s: Stream, target: Option<u32>, min_max: bool) -> usize {
+    pub fn push_stream(&mut self, mut s: Stream, target: Option<u32>, min_max: bool) -> usize {
+        let count = s.len();
+        let bounds = if min_max { s.bounds() } else { None };
+        // Vertex attributes of 8- and 16-bit components (quantized data) need 4-byte strides.
+        let mut stride = None;
+        if target == Some(34962) {
+            if let Some((bytes, st)) = s.padded_to_4() {
+                stride = Some(st);
+                s.data = bytes;
+            }
+        }
         if self.buffers.is_empty() || self.json.pointer("/buffers/0").is_none() {
             self.buffers.clear();
             self.json["buffers"] = json!([]);
@@ -401,6 +423,9 @@ impl Scene {
         // byteOffset 0 rather than none: the writer edits the key in place, so the view's keys
         // keep the order they always had in the output.
         let mut view = json!({ "buffer": self.buffers.len(), "byteOffset": 0, "byteLength": s.data.len() });
+        if let Some(st) = stride {
+            view["byteStride"] = json!(st);
+        }
         if let Some(t) = target {
             view["target"] = json!(t);
         }
@@ -410,7 +435,7 @@ impl Scene {
         let mut acc = json!({
             "bufferView": vi,
             "componentType": s.format.component_type,
-            "count": s.len(),
+            "count": count,
             "type": s.format.ty,
         });
         if s.format.normalized {
@@ -423,18 +448,9 @@ impl Scene {
                 }
             }
         }
-        if min_max && s.len() > 0 {
-            let n = s.format.components();
-            let mut lo = vec![f32::INFINITY; n];
-            let mut hi = vec![f32::NEG_INFINITY; n];
-            s.for_each_element(|_, v| {
-                for (c, &x) in v.iter().enumerate() {
-                    lo[c] = lo[c].min(x);
-                    hi[c] = hi[c].max(x);
-                }
-            });
-            acc["min"] = json!(lo);
-            acc["max"] = json!(hi);
+        if let Some((lo, hi)) = bounds {
+            acc["min"] = lo;
+            acc["max"] = hi;
         }
         array_mut(&mut self.json, "buffers").push(json!({ "byteLength": s.data.len() }));
         self.buffers.push(s.data);

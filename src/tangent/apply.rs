@@ -42,9 +42,6 @@ pub fn needs_tangents(scene: &Scene, r: PrimRef, all: bool) -> std::result::Resu
         // glTF lets a primitive leave POSITION out (clients skip drawing it); there is no surface.
         return Err("no POSITION (nothing to draw)".into());
     }
-    if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
-        return Err("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".into());
-    }
     let set = match (scene.material_of(r), scene.normal_texcoord(r)) {
         (_, Some(set)) => set,
         (_, None) if all => 0,
@@ -60,7 +57,7 @@ pub fn needs_tangents(scene: &Scene, r: PrimRef, all: bool) -> std::result::Resu
 /// Gives every primitive that needs them MikkTSpace tangents; returns a report per primitive.
 pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> {
     let mut reports = Vec::new();
-    let mut work: Vec<(PrimRef, u32, Primitive, Option<String>)> = Vec::new();
+    let mut work: Vec<(PrimRef, u32, Primitive, Options)> = Vec::new();
     for r in scene.primitives() {
         let report = |action, reason: Option<String>, uv_set| PrimReport {
             mesh: r.mesh,
@@ -89,8 +86,9 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
                     Some(_) => Some("existing tangents replaced (--overwrite)".into()),
                     None => None,
                 };
-                reports.push(report("generated", why.clone(), Some(set)));
-                work.push((r, set, p, why));
+                reports.push(report("generated", why, Some(set)));
+                let frames = Options { uv_transform: scene.normal_uv_transform(r), ..opts.frames };
+                work.push((r, set, p, frames));
             }
         }
     }
@@ -99,7 +97,7 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
     scene.release_primitives(&refs);
     let v_up = scene.uv_v_up;
     let done: Vec<(Primitive, FrameStats)> =
-        work.into_par_iter().map(|(_, set, p, _)| primitive_with_stats(p, set, v_up, &opts.frames)).collect();
+        work.into_par_iter().map(|(_, set, p, frames)| primitive_with_stats(p, set, v_up, &frames)).collect();
     for (r, (p, stats)) in refs.iter().zip(done) {
         scene.put_primitive(*r, p);
         if let Some(rep) = reports.iter_mut().find(|x| x.mesh == r.mesh && x.primitive == r.primitive) {

@@ -11,7 +11,7 @@ pub mod frames;
 pub mod mikk;
 
 use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
-use crate::scene::{flat_normals, Primitive};
+use crate::scene::{dequant, flat_normals, Primitive};
 use fallback::FallbackCounts;
 use glam::Vec3;
 
@@ -31,6 +31,8 @@ pub struct Options {
     /// Also write `_BITANGENT = cross(N, T) * w`.
     pub bitangents: bool,
     pub engine: mikk::Engine,
+    /// The normal texture's KHR_texture_transform: frames follow the UVs it is sampled with.
+    pub uv_transform: Option<crate::scene::dequant::UvTransform>,
 }
 
 /// What happened to one primitive.
@@ -76,6 +78,7 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
     // the surface is a point.
     let positions = p.attr("POSITION").map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 3]; n_vertices].into());
     let uvs = p.attr(&uv_name).map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
+    let uvs = dequant::transformed_uvs(uvs, opts.uv_transform.as_ref());
 
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
@@ -92,7 +95,7 @@ fn split_plan(p: &Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Spl
         );
         (flat.as_slice().into(), corner_ids.as_slice(), frames)
     } else {
-        let n = p.attr("NORMAL").map(|s| s.as_f32()).unwrap_or_default();
+        let n = p.attr("NORMAL").map(dequant::unit_normals).unwrap_or_default();
         let frames = generate_with_stack(
             &TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices },
             opts.engine,

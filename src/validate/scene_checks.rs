@@ -1,10 +1,10 @@
 //! Runs the checks over a whole scene: each primitive (presence, frames, handedness,
 //! conformance, degenerate triangles), node transforms, and each normal-map image once.
 
-use super::frames::{self, Explained, PrimData};
+use super::frames::{self, Explained, PrimData, Quant};
 use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
 use crate::error::Result;
-use crate::scene::{PrimRef, Scene};
+use crate::scene::{dequant, PrimRef, Scene};
 use crate::tangent::apply::to_triangle_list;
 use rayon::prelude::*;
 use serde_json::Value;
@@ -19,8 +19,8 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.primitive = Some(r.primitive);
         let pj = scene.prim_json(r);
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
-        let why = if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
-            Some("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".to_string())
+        let why = if let Some(why) = crate::scene::draco::why_unreadable(scene, r) {
+            Some(why)
         } else if !(4..=6).contains(&mode) {
             Some(format!("not triangles (mode {mode})"))
         } else {
@@ -49,11 +49,22 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         }
         let map_set = scene.normal_texcoord(r);
         let uv_name = format!("TEXCOORD_{}", map_set.unwrap_or(0));
+        // Compared as a renderer sees them: quantized normals made unit, UVs through the normal
+        // texture's transform.
+        let uv_t = scene.normal_uv_transform(r);
+        let step = |name: &str| p.attr(name).map_or(0.0, |s| s.step() as f64);
+        let quant = Quant {
+            position: step("POSITION"),
+            normal: step("NORMAL"),
+            uv: step(&uv_name) * uv_t.as_ref().map_or(1.0, |t| t.max_stretch()),
+            tangent: step("TANGENT"),
+        };
         let d = PrimData {
             positions: p.positions(),
-            normals: p.attr("NORMAL").map(|s| s.to_f32::<3>()),
-            uvs: p.attr(&uv_name).map(|s| s.to_f32::<2>()),
+            normals: p.attr("NORMAL").map(|s| dequant::unit_normals(s).into_owned()),
+            uvs: p.attr(&uv_name).map(|s| dequant::transformed_uvs(s.as_f32(), uv_t.as_ref()).into_owned()),
             tangents: p.attr("TANGENT").map(|s| s.to_f32::<4>()),
+            quant,
             indices: p.indices,
             uv_v_up: scene.uv_v_up,
         };
