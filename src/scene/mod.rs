@@ -269,6 +269,13 @@ impl Scene {
         if let Some(why) = draco::why_unreadable(self, r) {
             return Err(self.err(why));
         }
+        self.declared_primitive(r)
+    }
+
+    /// The primitive as its accessors declare it, for listing: the same as
+    /// [`primitive`](Self::primitive), except that a Draco-compressed primitive reads as the right
+    /// counts and formats with zeros for data (its accessors have no bytes of their own).
+    pub fn declared_primitive(&self, r: PrimRef) -> Result<Primitive> {
         let pj = self.prim_json(r);
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
         let attrs = pj
