@@ -212,3 +212,22 @@ fn every_command_on_every_corpus_file_succeeds_or_says_why() {
         run_ok(&["inspect", s(f)]);
     }
 }
+
+#[test]
+fn preview_draws_quantized_files_as_their_float_original() {
+    // gltfpack's UVs only land on the textures through the KHR_texture_transform it adds; the
+    // quantized file must render like the float one it was made from.
+    let d = scratch_dir("real_preview");
+    let render = |name: &str| {
+        let out = d.join(format!("{name}.png"));
+        run_ok(&["preview", s(&real(name)), "-o", s(&out), "--size", "128x128"]);
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let float = render("mirror_small.glb");
+    for name in ["mirror_small.gltfpack.glb", "mirror_small.quantize.glb", "mirror_small.gltfpack-c.glb"] {
+        let q = render(name);
+        let diff: u64 = float.as_raw().iter().zip(q.as_raw()).map(|(a, b)| a.abs_diff(*b) as u64).sum();
+        let mean = diff as f64 / float.as_raw().len() as f64;
+        assert!(mean < 2.0, "{name}: mean difference {mean:.2} of 255 from the float original");
+    }
+}

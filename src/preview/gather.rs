@@ -22,6 +22,20 @@ pub struct TexRef {
     pub sampler: Sampler,
     /// Which UV set: 0 for `TEXCOORD_0`, 1 for `TEXCOORD_1`.
     pub texcoord: u32,
+    /// KHR_texture_transform, applied to the interpolated UVs (it is affine, so that is exact).
+    pub transform: Option<crate::scene::dequant::UvTransform>,
+}
+
+impl TexRef {
+    /// The texel a fragment with UV sets `uv` sees.
+    pub fn sample(&self, uv: &[Vec2; 2]) -> Vec4 {
+        let at = uv[self.texcoord as usize];
+        let at = match &self.transform {
+            Some(t) => Vec2::from(t.apply(at.to_array())),
+            None => at,
+        };
+        self.texture.sample(&self.sampler, at)
+    }
 }
 
 /// The parts of a glTF material the seeds' shading model uses.
@@ -292,9 +306,6 @@ impl Cx<'_> {
             self.notes.push(format!("texture {ti} reads TEXCOORD_{texcoord}; only sets 0 and 1 are drawn"));
             return Ok(None);
         }
-        if info.pointer("/extensions/KHR_texture_transform").is_some() {
-            self.notes.push(format!("texture {ti}: KHR_texture_transform offset/scale/rotation is not applied"));
-        }
         let texture = match self.textures.get(&(img, srgb)) {
             Some(t) => t.clone(),
             None => {
@@ -304,7 +315,8 @@ impl Cx<'_> {
                 t
             }
         };
-        Ok(Some(TexRef { texture, sampler, texcoord: texcoord as u32 }))
+        let transform = crate::scene::dequant::UvTransform::from_texture_info(info);
+        Ok(Some(TexRef { texture, sampler, texcoord: texcoord as u32, transform }))
     }
 }
 

@@ -214,7 +214,7 @@ impl Fragment<'_> {
         if self.draw.uvs[nt.texcoord as usize].is_empty() {
             return Vec3::Z;
         }
-        let texel = nt.texture.sample(&nt.sampler, i.uv[nt.texcoord as usize]);
+        let texel = nt.sample(&i.uv);
         let s = self.material.normal_scale;
         let n = (texel.truncate() * 2.0 - Vec3::ONE) * Vec3::new(s, s, 1.0);
         let n = n.normalize_or_zero();
@@ -230,7 +230,7 @@ impl Fragment<'_> {
         let mut c: Vec4 = self.material.base_color;
         if let Some(bt) = &self.material.base_texture {
             if !self.draw.uvs[bt.texcoord as usize].is_empty() {
-                c *= bt.texture.sample(&bt.sampler, i.uv[bt.texcoord as usize]);
+                c *= bt.sample(&i.uv);
             }
         }
         c.truncate().max(Vec3::ZERO)

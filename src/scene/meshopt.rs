@@ -221,6 +221,93 @@ mod tests {
         assert!(json["buffers"][1].get("extensions").is_none());
     }
 
+    /// Decodes one compressed view of `count` elements of `stride` bytes through the glTF layer.
+    fn decode_one(encoded: &[u8], stride: usize, count: usize, mode: &str, filter: &str) -> Vec<u8> {
+        let mut json = json!({
+            "buffers": [{"byteLength": encoded.len()}, {"byteLength": stride * count}],
+            "bufferViews": [{"buffer": 1, "byteLength": stride * count, "extensions": {"EXT_meshopt_compression":
+                {"buffer": 0, "byteLength": encoded.len(), "byteStride": stride, "count": count,
+                 "mode": mode, "filter": filter}}}]
+        });
+        let mut buffers = vec![encoded.to_vec(), vec![0u8; stride * count]];
+        decode_all(Path::new("t.glb"), &mut json, &mut buffers).unwrap();
+        buffers.pop().unwrap()
+    }
+
+    fn encode_vertices(filtered: &[u8], stride: usize) -> Vec<u8> {
+        let count = filtered.len() / stride;
+        let mut out = vec![0u8; unsafe { ::meshopt::ffi::meshopt_encodeVertexBufferBound(count, stride) }];
+        // SAFETY: `out` is the bound meshoptimizer asks for; `filtered` holds count * stride bytes.
+        let n = unsafe {
+            ::meshopt::ffi::meshopt_encodeVertexBuffer(
+                out.as_mut_ptr(),
+                out.len(),
+                filtered.as_ptr().cast(),
+                count,
+                stride,
+            )
+        };
+        out.truncate(n);
+        out
+    }
+
+    #[test]
+    fn octahedral_quaternion_and_exponential_filters_decode_to_the_encoded_values() {
+        let count = 64;
+        let unit: Vec<[f32; 4]> = (0..count)
+            .map(|i| {
+                let (a, b) = (i as f32 * 0.37, i as f32 * 0.11);
+                [a.cos() * b.cos(), a.sin() * b.cos(), b.sin(), if i % 2 == 0 { 1.0 } else { -1.0 }]
+            })
+            .collect();
+        let flat: Vec<f32> = unit.iter().flatten().copied().collect();
+        // Octahedral, 16-bit components (stride 8): unit vectors with w carried.
+        let mut filtered = vec![0u8; count * 8];
+        // SAFETY: `filtered` holds count * 8 bytes, `flat` count * 4 floats.
+        unsafe { ::meshopt::ffi::meshopt_encodeFilterOct(filtered.as_mut_ptr().cast(), count, 8, 16, flat.as_ptr()) };
+        let out = decode_one(&encode_vertices(&filtered, 8), 8, count, "ATTRIBUTES", "OCTAHEDRAL");
+        for (v, e) in unit.iter().zip(out.chunks_exact(8)) {
+            let c = |k: usize| i16::from_le_bytes([e[2 * k], e[2 * k + 1]]) as f32 / 32767.0;
+            assert!((0..3).all(|k| (c(k) - v[k]).abs() < 1e-3), "{v:?}");
+            assert_eq!(c(3), v[3]);
+        }
+        // Quaternion (stride 8): unit quaternions up to sign.
+        let q: Vec<f32> =
+            unit.iter().flat_map(|v| glam::Quat::from_xyzw(v[0], v[1], v[2], 0.5).normalize().to_array()).collect();
+        unsafe { ::meshopt::ffi::meshopt_encodeFilterQuat(filtered.as_mut_ptr().cast(), count, 8, 12, q.as_ptr()) };
+        let out = decode_one(&encode_vertices(&filtered, 8), 8, count, "ATTRIBUTES", "QUATERNION");
+        for (v, e) in q.chunks_exact(4).zip(out.chunks_exact(8)) {
+            let c = |k: usize| i16::from_le_bytes([e[2 * k], e[2 * k + 1]]) as f32 / 32767.0;
+            let dot: f32 = (0..4).map(|k| c(k) * v[k]).sum();
+            assert!(dot.abs() > 0.9999, "{v:?}: {dot}");
+        }
+        // Exponential (stride 16): floats to about 2^-15 relative.
+        let big: Vec<f32> = flat.iter().enumerate().map(|(i, x)| x * (i as f32 + 1.0) * 1000.0).collect();
+        let mut filtered = vec![0u8; count * 16];
+        unsafe {
+            ::meshopt::ffi::meshopt_encodeFilterExp(filtered.as_mut_ptr().cast(), count, 16, 16, big.as_ptr(), 0)
+        };
+        let out = decode_one(&encode_vertices(&filtered, 16), 16, count, "ATTRIBUTES", "EXPONENTIAL");
+        for (x, e) in big.iter().zip(out.chunks_exact(4)) {
+            let y = f32::from_le_bytes([e[0], e[1], e[2], e[3]]);
+            assert!((x - y).abs() <= x.abs() * 1e-4 + 1e-6, "{x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn index_sequences_decode_exactly() {
+        let idx: Vec<u32> = (0..90u32).map(|i| (i * 13) % 40).collect();
+        // SAFETY: the buffer is the bound meshoptimizer asks for.
+        let mut out = vec![0u8; unsafe { ::meshopt::ffi::meshopt_encodeIndexSequenceBound(idx.len(), 40) }];
+        let n = unsafe {
+            ::meshopt::ffi::meshopt_encodeIndexSequence(out.as_mut_ptr(), out.len(), idx.as_ptr(), idx.len())
+        };
+        out.truncate(n);
+        let got = decode_one(&out, 2, idx.len(), "INDICES", "NONE");
+        let got: Vec<u32> = got.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]]) as u32).collect();
+        assert_eq!(got, idx);
+    }
+
     #[test]
     fn damaged_or_oversized_views_are_errors_naming_the_extension() {
         let mut json = json!({
