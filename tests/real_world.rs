@@ -231,3 +231,22 @@ fn preview_draws_quantized_files_as_their_float_original() {
         assert!(mean < 2.0, "{name}: mean difference {mean:.2} of 255 from the float original");
     }
 }
+
+#[test]
+fn position_accessors_leave_with_bounds_even_when_the_input_had_none() {
+    let mut g = Gltf::new();
+    let p = g.floats(&[[0.0, 0.0, 0.0], [2.0, 0.0, -1.0], [0.0, 3.0, 0.5]], Some(34962));
+    let n = g.floats(&[[0.0, 0.0, 1.0]; 3], Some(34962));
+    g.mesh(serde_json::json!({ "attributes": { "POSITION": p, "NORMAL": n } }));
+    for key in ["min", "max"] {
+        g.json["accessors"][p].as_object_mut().unwrap().remove(key);
+    }
+    let input = scratch_dir("real_bounds").join("no_bounds.glb");
+    g.write_glb(&input);
+    assert!(load(&input).json["accessors"][p].get("min").is_none());
+    let out = validated_dir("real_bounds").join("bounds.glb");
+    run_ok(&["tangents", s(&input), "-o", s(&out), "-q"]);
+    let acc = &load(&out).json["accessors"][0];
+    assert_eq!(acc["min"], serde_json::json!([0.0, 0.0, -1.0]));
+    assert_eq!(acc["max"], serde_json::json!([2.0, 3.0, 0.5]));
+}
