@@ -250,3 +250,31 @@ fn position_accessors_leave_with_bounds_even_when_the_input_had_none() {
     assert_eq!(acc["min"], serde_json::json!([0.0, 0.0, -1.0]));
     assert_eq!(acc["max"], serde_json::json!([2.0, 3.0, 0.5]));
 }
+
+#[test]
+fn a_rotated_texture_transform_turns_the_tangent_with_it() {
+    // A flat quad with u along +x and v along +y. The normal texture turns its UVs by 90°
+    // (u' = v, v' = -u), so the map's +x runs along +y on the surface: that is the tangent.
+    for (rotation, expected) in [(0.0, [1.0, 0.0, 0.0]), (std::f64::consts::FRAC_PI_2, [0.0, 1.0, 0.0])] {
+        let mut g = Gltf::new();
+        let p = g.floats(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]], Some(34962));
+        let n = g.floats(&[[0.0, 0.0, 1.0]; 4], Some(34962));
+        let t = g.floats(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], Some(34962));
+        let i = g.indices(&[0, 1, 2, 0, 2, 3]);
+        let tex = g.texture();
+        let m = g.material(serde_json::json!({
+            "normalTexture": { "index": tex, "extensions": { "KHR_texture_transform": { "rotation": rotation } } }
+        }));
+        g.json["extensionsUsed"] = serde_json::json!(["KHR_texture_transform"]);
+        g.mesh(serde_json::json!({ "attributes": { "POSITION": p, "NORMAL": n, "TEXCOORD_0": t }, "indices": i, "material": m }));
+        let input = scratch_dir("real_rotated_uv").join("quad.glb");
+        g.write_glb(&input);
+        let out = validated_dir(&format!("real_rotated_uv_{}", rotation != 0.0)).join("quad.glb");
+        run_ok(&["tangents", s(&input), "-o", s(&out), "-q"]);
+        for tan in corner_attr::<4>(&load(&out), P0, "TANGENT") {
+            let d: f32 = (0..3).map(|k| tan[k] * expected[k]).sum();
+            assert!(d > 0.9999, "rotation {rotation}: tangent {tan:?}, expected {expected:?}");
+            assert_eq!(tan[3], -1.0);
+        }
+    }
+}

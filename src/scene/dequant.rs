@@ -2,10 +2,11 @@
 //! unit length, and UVs through the KHR_texture_transform that dequantizes them (gltfpack puts one
 //! on every texture of a material whose UVs it quantized).
 //!
-//! Positions need no such step for tangents: glTF-Transform and gltfpack dequantize them with a
-//! uniform scale and a translation on the node, and MikkTSpace only measures angles and
-//! directions, which a uniform scale and a translation keep. (A non-uniform node scale would change
-//! them, but tangents are mesh-local by the conventions, whatever the node does.)
+//! Positions are left in mesh space, as the conventions ask. glTF-Transform and gltfpack
+//! dequantize them with a uniform scale and a translation on the node, which keep every angle and
+//! direction MikkTSpace measures. Even a non-uniform node matrix `M` would change little: each
+//! triangle's tangent (dP/du) maps to exactly `M` times itself, and orthogonality to the normal
+//! survives (normals map by `M^-T`); only the angle weights of MikkTSpace's vertex average change.
 
 use super::accessor::{Stream, FLOAT};
 use serde_json::Value;
