@@ -278,3 +278,22 @@ fn a_rotated_texture_transform_turns_the_tangent_with_it() {
         }
     }
 }
+
+#[test]
+fn valid_quantized_tangents_are_kept_as_they_are() {
+    let d = validated_dir("real_kept");
+    for name in ["mirror_small.gltfpack.glb", "mirror_small.quantize.glb"] {
+        let out = d.join(name);
+        let o = run_ok(&["tangents", s(&real(name)), "-o", s(&out), "--json"]);
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(report["kept"], 1, "{name}: {report}");
+        let (a, b) = (load(&real(name)), load(&out));
+        let tangent = |sc: &bumpbake::scene::Scene| sc.primitive(P0).unwrap().attr("TANGENT").unwrap().clone();
+        let (ta, tb) = (tangent(&a), tangent(&b));
+        assert_eq!(
+            (ta.format, ta.data),
+            (tb.format, tb.data),
+            "{name}: the authored quantized tangents, byte for byte"
+        );
+    }
+}
