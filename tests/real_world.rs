@@ -146,6 +146,13 @@ fn draco_primitives_that_need_tangents_are_refused_with_the_way_out() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("gltf-transform"), "names the way out");
         assert!(std::fs::read_dir(&d).unwrap().next().is_none(), "{args:?}: nothing written");
     }
+    // validate cannot check its frames: a warning, so `--strict` does not pass it silently.
+    let o = run(&["validate", "--strict", "--format", "json", s(&input)]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(out.contains("PRIMITIVE_COMPRESSED") && out.contains("gltf-transform"), "{out}");
+    // Without --strict it passes, saying what it did not check.
+    assert_eq!(run(&["validate", s(&input)]).status.code(), Some(0));
 }
 
 /// The files `.ci/corpus.sh` made, or `None` (with a note) outside CI when there are none.

@@ -19,18 +19,22 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.primitive = Some(r.primitive);
         let pj = scene.prim_json(r);
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
-        let why = if let Some(why) = crate::scene::draco::why_unreadable(scene, r) {
-            Some(why)
+        // A compressed primitive whose normal map needs frames is a warning: its frames go
+        // unchecked, and `--strict` must not pass them silently.
+        let (code, why) = if let Some(why) = crate::scene::draco::why_unreadable(scene, r) {
+            let code = if scene.normal_texcoord(r).is_some() {
+                Code::PRIMITIVE_COMPRESSED
+            } else {
+                Code::PRIMITIVE_NOT_CHECKED
+            };
+            (code, Some(why))
         } else if !(4..=6).contains(&mode) {
-            Some(format!("not triangles (mode {mode})"))
+            (Code::PRIMITIVE_NOT_CHECKED, Some(format!("not triangles (mode {mode})")))
         } else {
-            None
+            (Code::PRIMITIVE_NOT_CHECKED, None)
         };
         if let Some(why) = why {
-            s.check(
-                Code::PRIMITIVE_NOT_CHECKED,
-                Some(Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", format!("not checked: {why}"))),
-            );
+            s.check(code, Some(Finding::new(code, 1, 1, "primitives", format!("not checked: {why}"))));
             subjects.push((s, None));
             continue;
         }
