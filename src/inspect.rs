@@ -87,7 +87,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let mut primitives = Vec::new();
     for r in scene.primitives() {
         let pj = scene.prim_json(r).clone();
-        let p = scene.primitive(r)?;
+        let p = scene.declared_primitive(r)?;
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
         let need = needs_tangents(&scene, &mats, r, false);
         let by = need.as_ref().ok().and_then(|u| u.need.as_ref());

@@ -163,6 +163,102 @@ impl Stream {
         }
     }
 
+    /// The `min` and `max` glTF wants for this stream: per component, in the stream's own component
+    /// type (integers stay integers, and `normalized` does not apply: glTF bounds are the stored
+    /// values). `None` for an empty stream.
+    pub fn bounds(&self) -> Option<(serde_json::Value, serde_json::Value)> {
+        let n = self.format.components();
+        if self.is_empty() || n == 0 {
+            return None;
+        }
+        if self.format.component_type == FLOAT {
+            let mut lo = vec![f32::INFINITY; n];
+            let mut hi = vec![f32::NEG_INFINITY; n];
+            self.for_each_element(|_, v| {
+                for (c, &x) in v.iter().enumerate() {
+                    lo[c] = lo[c].min(x);
+                    hi[c] = hi[c].max(x);
+                }
+            });
+            return Some((serde_json::json!(lo), serde_json::json!(hi)));
+        }
+        let mut lo = vec![i64::MAX; n];
+        let mut hi = vec![i64::MIN; n];
+        for i in 0..self.len() {
+            for c in 0..n {
+                let x = self.raw(i, c);
+                lo[c] = lo[c].min(x);
+                hi[c] = hi[c].max(x);
+            }
+        }
+        Some((serde_json::json!(lo), serde_json::json!(hi)))
+    }
+
+    /// Element `i`, component `c` of an integer stream, as stored.
+    pub fn raw(&self, i: usize, c: usize) -> i64 {
+        let cs = component_size(self.format.component_type).unwrap_or(4);
+        let at = i * self.format.elem_size() + c * cs;
+        let b = &self.data[at..at + cs];
+        match self.format.component_type {
+            BYTE => b[0] as i8 as i64,
+            UNSIGNED_BYTE => b[0] as i64,
+            SHORT => i16::from_le_bytes([b[0], b[1]]) as i64,
+            UNSIGNED_SHORT => u16::from_le_bytes([b[0], b[1]]) as i64,
+            _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i64,
+        }
+    }
+
+    /// How finely the stream was quantized, in the units [`Self::get`] returns: each stored value
+    /// is within half a step of the value that was quantized. Zero for floats, 1 for plain
+    /// integers. Normalized integers are often quantized to fewer bits than they are stored in
+    /// (glTF-Transform stores 12-bit UVs and 10-bit normals in 16 bits, as integer multiples of
+    /// `65535 / 4095` and `32767 / 511`): the step is that of the fewest bits every stored value
+    /// is consistent with, to within one stored unit (tools round twice: to their bits, then to
+    /// the storage type). Streams with fewer than 16 distinct values say too little to tell and
+    /// get their type's full precision.
+    pub fn step(&self) -> f32 {
+        let (bits, signed) = match (self.format.component_type, self.format.normalized) {
+            (FLOAT, _) => return 0.0,
+            (BYTE, true) => (8, true),
+            (UNSIGNED_BYTE, true) => (8, false),
+            (SHORT, true) => (16, true),
+            (UNSIGNED_SHORT, true) => (16, false),
+            _ => return 1.0,
+        };
+        let levels = |b: u32| if signed { ((1u32 << (b - 1)) - 1) as f64 } else { ((1u32 << b) - 1) as f64 };
+        let full = levels(bits);
+        let n = self.format.components();
+        let mut values: Vec<i64> =
+            (0..self.len()).flat_map(|i| (0..n).map(move |c| (i, c))).map(|(i, c)| self.raw(i, c)).collect();
+        values.sort_unstable();
+        values.dedup();
+        if values.len() < 16 {
+            return (1.0 / full) as f32;
+        }
+        let fits = |b: u32| {
+            let k = full / levels(b);
+            values.iter().all(|&r| (r as f64 - (r as f64 / k).round() * k).abs() <= 1.0 + 1e-6)
+        };
+        let b = (2..=bits).find(|&b| fits(b)).unwrap_or(bits);
+        (1.0 / levels(b)) as f32
+    }
+
+    /// The stream laid out for a vertex buffer view: each element padded with zeros to a multiple
+    /// of 4 bytes, as glTF requires of vertex attributes. Returns the bytes and the stride, or
+    /// `None` when the elements are aligned already.
+    pub fn padded_to_4(&self) -> Option<(Vec<u8>, usize)> {
+        let es = self.format.elem_size();
+        if es == 0 || es.is_multiple_of(4) {
+            return None;
+        }
+        let stride = es.next_multiple_of(4);
+        let mut out = vec![0u8; stride * self.len()];
+        for (dst, src) in out.chunks_exact_mut(stride).zip(self.data.chunks_exact(es)) {
+            dst[..es].copy_from_slice(src);
+        }
+        Some((out, stride))
+    }
+
     /// Copies the elements named by `order` into a new stream (a gather).
     pub fn gather(&self, order: &[u32]) -> Stream {
         let s = self.format.elem_size();
@@ -184,6 +280,42 @@ impl Stream {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn integer_bounds_are_stored_values_and_vertex_layouts_are_padded() {
+        let s = Stream {
+            format: Format { component_type: SHORT, ty: "VEC3".into(), normalized: true },
+            data: [-32767i16, 5, 0, 100, -2, 32767].iter().flat_map(|x| x.to_le_bytes()).collect(),
+            template: None,
+        };
+        let (lo, hi) = s.bounds().unwrap();
+        assert_eq!(lo.to_string(), "[-32767,-2,0]");
+        assert_eq!(hi.to_string(), "[100,5,32767]");
+        let (bytes, stride) = s.padded_to_4().unwrap();
+        assert_eq!(stride, 8);
+        assert_eq!(&bytes[..6], &s.data[..6]);
+        assert_eq!(&bytes[6..8], &[0, 0]);
+        assert_eq!(&bytes[8..14], &s.data[6..12]);
+        assert!(Stream::from_f32("VEC3", &[[1.0, 2.0, 3.0]]).padded_to_4().is_none());
+        assert_eq!(Stream::from_f32("VEC2", &[[1.0, -2.0]]).bounds().unwrap().0.to_string(), "[1.0,-2.0]");
+    }
+
+    #[test]
+    fn the_step_is_that_of_the_bits_the_values_were_quantized_to() {
+        // 12-bit UVs stored as normalized 16-bit integers, as glTF-Transform writes them.
+        let raw: Vec<u16> = (0..4095u32).step_by(7).map(|q| (q as f64 * 65535.0 / 4095.0).round() as u16).collect();
+        let s = Stream {
+            format: Format { component_type: UNSIGNED_SHORT, ty: "VEC2".into(), normalized: true },
+            data: raw.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            template: None,
+        };
+        assert_eq!(s.step(), 1.0 / 4095.0);
+        let full: Vec<u16> = (0..100u16).map(|x| x * 601 + 3).collect();
+        let s = Stream { data: full.iter().flat_map(|x| x.to_le_bytes()).collect(), ..s };
+        // Within one stored unit, every integer is a multiple of the 15-bit step.
+        assert!(s.step() <= 1.0 / 32767.0, "{}", s.step());
+        assert_eq!(Stream::from_f32("VEC2", &[[0.5, 0.5]]).step(), 0.0);
+    }
 
     #[test]
     fn indices_above_two_to_the_24_are_exact() {

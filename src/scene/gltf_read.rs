@@ -1,7 +1,7 @@
 //! Reading `.gltf` and `.glb` into a [`Scene`], checking every reference before it is followed.
 
 use super::accessor::*;
-use super::{as_index, uri, ReadOptions, Scene};
+use super::{as_index, meshopt, uri, ReadOptions, Scene};
 use crate::error::{Error, Result};
 use serde_json::Value;
 use std::path::Path;
@@ -84,7 +84,7 @@ fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value> {
     }
 }
 
-fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> Result<Scene> {
+fn build(path: &Path, mut json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> Result<Scene> {
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mut buffers = Vec::new();
     let mut deps = Vec::new();
@@ -102,9 +102,13 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
                 }
                 uri::read(u, &base_dir, path, opts.allow_outside)?
             }
-            None if i == 0 => {
-                bin.take().ok_or_else(|| Error::input(path, "buffer 0 has no uri and there is no GLB binary chunk"))?
+            None if i == 0 && bin.is_some() => bin.take().unwrap_or_default(),
+            // Room for what EXT_meshopt_compression decodes into it.
+            None if meshopt::is_fallback(b) && declared <= 1 << 31 => vec![0; declared],
+            None if meshopt::is_fallback(b) => {
+                return Err(Error::input(path, format!("buffer {i}: {declared} bytes is absurd for a fallback buffer")))
             }
+            None if i == 0 => return Err(Error::input(path, "buffer 0 has no uri and there is no GLB binary chunk")),
             None => return Err(Error::input(path, format!("buffer {i} has no uri"))),
         };
         if data.len() < declared {
@@ -115,6 +119,10 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
         }
         buffers.push(data);
     }
+    let mut notes = Vec::new();
+    if meshopt::decode_all(path, &mut json, &mut buffers)? {
+        notes.push(format!("{}: decoded; the output is written without it (uncompressed)", meshopt::EXT));
+    }
     let scene = Scene {
         json,
         buffers,
@@ -122,7 +130,7 @@ fn build(path: &Path, json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> 
         base_dir,
         allow_outside: opts.allow_outside,
         uv_v_up: false,
-        notes: Vec::new(),
+        notes,
         deps,
         height_maps: Vec::new(),
         ledger: Default::default(),

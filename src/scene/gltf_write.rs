@@ -12,6 +12,7 @@ use crate::output::Outputs;
 use base64::Engine as _;
 use serde_json::{json, Value};
 use std::borrow::Cow;
+use std::collections::BTreeSet;
 use std::path::Path;
 
 #[derive(Debug, Clone, Default)]
@@ -63,6 +64,7 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
         _ => return Err(Error::usage(format!("{}: output must end in .gltf or .glb", out.display()))),
     };
     let mut json = scene.json.clone();
+    add_position_bounds(scene, &mut json)?;
     let held: usize = scene.buffers.iter().map(|b| b.len()).sum();
     let mut stats = WriteStats { buffer_bytes_in: held + scene.ledger.bytes_unheld, ..Default::default() };
     let keep_all = unknown_data_refs(&json);
@@ -202,6 +204,34 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
         files.add(out, text);
     }
     Ok((files, stats))
+}
+
+/// glTF requires `min` and `max` on every POSITION accessor (morph targets' too); inputs that lack
+/// them get them from their data, in the accessor's own component type.
+fn add_position_bounds(scene: &Scene, json: &mut Value) -> Result<()> {
+    let mut missing = BTreeSet::new();
+    for mesh in json.get("meshes").and_then(|m| m.as_array()).into_iter().flatten() {
+        for p in mesh.get("primitives").and_then(|p| p.as_array()).into_iter().flatten() {
+            let targets = p.get("targets").and_then(|t| t.as_array()).into_iter().flatten();
+            for set in std::iter::once(p.get("attributes")).chain(targets.map(Some)) {
+                if let Some(i) = set.and_then(|a| a.get("POSITION")).and_then(|i| i.as_u64()) {
+                    missing.insert(i as usize);
+                }
+            }
+        }
+    }
+    for i in missing {
+        let Some(acc) = json.pointer(&format!("/accessors/{i}")) else { continue };
+        // Accessors without data (Draco's) must carry their bounds already.
+        if (acc.get("min").is_some() && acc.get("max").is_some()) || acc.get("bufferView").is_none() {
+            continue;
+        }
+        if let Some((lo, hi)) = scene.accessor(i)?.bounds() {
+            json["accessors"][i]["min"] = lo;
+            json["accessors"][i]["max"] = hi;
+        }
+    }
+    Ok(())
 }
 
 fn views_len(json: &Value) -> usize {

@@ -25,10 +25,16 @@ pub struct UvTransform {
 impl UvTransform {
     /// The UV the texture is sampled at: `translation * rotation * scale * uv`, with the
     /// rotation matrix rows `(cos, sin)` and `(-sin, cos)`.
+    /// Computed in f64 so that dequantizing transforms (gltfpack's) round once, at the end.
     pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
-        let (s, c) = self.rotation.sin_cos();
-        let (u, v) = (uv[0] * self.scale[0], uv[1] * self.scale[1]);
-        [c * u + s * v + self.offset[0], -s * u + c * v + self.offset[1]]
+        let (s, c) = (self.rotation as f64).sin_cos();
+        let (u, v) = (uv[0] as f64 * self.scale[0] as f64, uv[1] as f64 * self.scale[1] as f64);
+        [(c * u + s * v + self.offset[0] as f64) as f32, (-s * u + c * v + self.offset[1] as f64) as f32]
+    }
+
+    /// The most a UV difference can grow through the transform (the larger of the scales).
+    pub fn max_stretch(&self) -> f64 {
+        (self.scale[0] as f64).abs().max((self.scale[1] as f64).abs())
     }
 
     /// Whether applying it changes nothing.
@@ -36,7 +42,8 @@ impl UvTransform {
         self.offset == [0.0, 0.0] && self.rotation == 0.0 && self.scale == [1.0, 1.0]
     }
 
-    fn from_info(info: &Value) -> Option<UvTransform> {
+    /// The transform a texture-info's extension describes, or `None` for none or the identity.
+    pub fn from_texture_info(info: &Value) -> Option<UvTransform> {
         let t = info.pointer("/extensions/KHR_texture_transform")?;
         let pair = |key: &str, default: [f32; 2]| {
             t.get(key)
@@ -419,7 +426,7 @@ impl Scene {
             pointer: pointer.to_string(),
             texture,
             tex_coord,
-            transform: UvTransform::from_info(info),
+            transform: UvTransform::from_texture_info(info),
             sampler: tj.and_then(|t| t.get("sampler")).and_then(as_index),
             images,
             colour,

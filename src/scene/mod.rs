@@ -8,10 +8,13 @@
 
 pub mod accessor;
 mod compact;
+pub mod dequant;
+pub mod draco;
 mod gltf_read;
 mod gltf_write;
 pub mod image_limits;
 pub mod material;
+mod meshopt;
 mod obj;
 pub mod refs;
 pub mod uri;
@@ -256,8 +259,24 @@ impl Scene {
         self.materials().default_of(self, r)?.texture(Slot::Normal).map(|t| t.tex_coord)
     }
 
+    /// The transform that the UVs deciding the primitive's tangents go through (the
+    /// `KHR_texture_transform` of the texture that needs them), if any.
+    pub fn normal_uv_transform(&self, r: PrimRef) -> Option<UvTransform> {
+        self.materials().tangent_need(self, r)?.need.transform
+    }
+
     /// Reads a primitive's streams, indices and morph targets.
     pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
+        if let Some(why) = draco::why_unreadable(self, r) {
+            return Err(self.err(why));
+        }
+        self.declared_primitive(r)
+    }
+
+    /// The primitive as its accessors declare it, for listing: the same as
+    /// [`primitive`](Self::primitive), except that a Draco-compressed primitive reads as the right
+    /// counts and formats with zeros for data (its accessors have no bytes of their own).
+    pub fn declared_primitive(&self, r: PrimRef) -> Result<Primitive> {
         let pj = self.prim_json(r);
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
         let attrs = pj
@@ -392,7 +411,17 @@ impl Scene {
     /// [`push_accessor`](Self::push_accessor) that moves the stream's bytes into a buffer of
     /// their own: no copy, and no growing buffer to reallocate. The writer packs all buffers
     /// into one anyway.
-    pub fn push_stream(&mut self, s: Stream, target: Option<u32>, min_max: bool) -> usize {
+    pub fn push_stream(&mut self, mut s: Stream, target: Option<u32>, min_max: bool) -> usize {
+        let count = s.len();
+        let bounds = if min_max { s.bounds() } else { None };
+        // Vertex attributes of 8- and 16-bit components (quantized data) need 4-byte strides.
+        let mut stride = None;
+        if target == Some(34962) {
+            if let Some((bytes, st)) = s.padded_to_4() {
+                stride = Some(st);
+                s.data = bytes;
+            }
+        }
         if self.buffers.is_empty() || self.json.pointer("/buffers/0").is_none() {
             self.buffers.clear();
             self.json["buffers"] = json!([]);
@@ -402,6 +431,9 @@ impl Scene {
         // byteOffset 0 rather than none: the writer edits the key in place, so the view's keys
         // keep the order they always had in the output.
         let mut view = json!({ "buffer": self.buffers.len(), "byteOffset": 0, "byteLength": s.data.len() });
+        if let Some(st) = stride {
+            view["byteStride"] = json!(st);
+        }
         if let Some(t) = target {
             view["target"] = json!(t);
         }
@@ -411,7 +443,7 @@ impl Scene {
         let mut acc = json!({
             "bufferView": vi,
             "componentType": s.format.component_type,
-            "count": s.len(),
+            "count": count,
             "type": s.format.ty,
         });
         if s.format.normalized {
@@ -424,18 +456,9 @@ impl Scene {
                 }
             }
         }
-        if min_max && !s.is_empty() {
-            let n = s.format.components();
-            let mut lo = vec![f32::INFINITY; n];
-            let mut hi = vec![f32::NEG_INFINITY; n];
-            s.for_each_element(|_, v| {
-                for (c, &x) in v.iter().enumerate() {
-                    lo[c] = lo[c].min(x);
-                    hi[c] = hi[c].max(x);
-                }
-            });
-            acc["min"] = json!(lo);
-            acc["max"] = json!(hi);
+        if let Some((lo, hi)) = bounds {
+            acc["min"] = lo;
+            acc["max"] = hi;
         }
         array_mut(&mut self.json, "buffers").push(json!({ "byteLength": s.data.len() }));
         self.buffers.push(s.data);

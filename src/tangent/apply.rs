@@ -61,9 +61,6 @@ pub fn needs_tangents(
         // glTF lets a primitive leave POSITION out (clients skip drawing it); there is no surface.
         return Err("no POSITION (nothing to draw)".into());
     }
-    if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
-        return Err("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".into());
-    }
     let uvs = match mats.tangent_need(scene, r) {
         Some(need) => TangentUvs { set: need.need.tex_coord, transform: need.need.transform, need: Some(need) },
         None if all => TangentUvs { set: 0, transform: None, need: None },
@@ -136,18 +133,22 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
     Ok(reports)
 }
 
-/// How many elements of a TANGENT stream break the glTF rules.
+/// How many elements of a TANGENT stream break the glTF rules. Quantized tangents
+/// (KHR_mesh_quantization: normalized BYTE or SHORT) are valid when they are unit to within what
+/// their step explains.
 pub fn invalid_tangents(t: &crate::scene::Stream) -> usize {
-    if t.format.ty != "VEC4" || t.format.component_type != crate::scene::accessor::FLOAT {
+    use crate::scene::accessor::{BYTE, FLOAT, SHORT};
+    let f = &t.format;
+    let quantized = f.normalized && matches!(f.component_type, BYTE | SHORT);
+    if f.ty != "VEC4" || !(f.component_type == FLOAT || quantized) {
         return t.len().max(1);
     }
+    let tolerance = (super::fallback::UNIT_TOLERANCE * 5.0).max(3f32.sqrt() / 2.0 * t.step());
     t.to_f32::<4>()
         .iter()
         .filter(|v| {
             let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            !(len.is_finite()
-                && (len - 1.0).abs() <= super::fallback::UNIT_TOLERANCE * 5.0
-                && (v[3] == 1.0 || v[3] == -1.0))
+            !(len.is_finite() && (len - 1.0).abs() <= tolerance && (v[3] == 1.0 || v[3] == -1.0))
         })
         .count()
 }

@@ -11,7 +11,7 @@ pub mod frames;
 pub mod mikk;
 
 use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
-use crate::scene::{flat_normals, Primitive, UvTransform};
+use crate::scene::{dequant, flat_normals, Primitive, UvTransform};
 use fallback::FallbackCounts;
 use glam::Vec3;
 
@@ -93,10 +93,8 @@ fn split_plan(
     // Borrowed from the streams where possible. Without POSITION (callers skip such primitives)
     // the surface is a point.
     let positions = p.attr("POSITION").map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 3]; n_vertices].into());
-    let mut uvs = p.attr(&uv_name).map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
-    if let Some(t) = transform {
-        uvs = uvs.iter().map(|&uv| t.apply(uv)).collect::<Vec<_>>().into();
-    }
+    let uvs = p.attr(&uv_name).map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
+    let uvs = dequant::transformed_uvs(uvs, transform);
 
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
@@ -115,7 +113,7 @@ fn split_plan(
         );
         (flat.as_slice().into(), corner_ids.as_slice(), frames)
     } else {
-        let n = p.attr("NORMAL").map(|s| s.as_f32()).unwrap_or_default();
+        let n = p.attr("NORMAL").map(dequant::unit_normals).unwrap_or_default();
         let frames = generate_with_stack(
             &TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices },
             opts.engine,

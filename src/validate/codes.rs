@@ -78,6 +78,9 @@ codes! {
     NODE_MIRRORED = Info, "renderers must flip the winding and the bitangent for mirrored instances; check that yours does";
     /// A primitive the checks cannot read (not triangles, compressed).
     PRIMITIVE_NOT_CHECKED = Info, "decompress or triangulate the mesh to have it checked";
+    /// A compressed primitive (KHR_draco_mesh_compression) whose normal texture needs frames that
+    /// cannot be checked.
+    PRIMITIVE_COMPRESSED = Warning, "decompress it to have its frames checked: `npx @gltf-transform/cli copy IN.glb OUT.glb` writes Draco meshes uncompressed";
     /// The normal texture's image could not be decoded (format, missing file).
     NORMALMAP_UNREADABLE = Warning, "use PNG (8 or 16 bit) for the normal map, or check that the file exists";
     /// Texels decode (n = 2*texel - 1) to z < 0: they point into the surface.

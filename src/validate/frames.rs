@@ -28,6 +28,90 @@ pub struct PrimData {
     pub indices: Vec<u32>,
     /// UVs have v up (OBJ): the stored `w` is the MikkTSpace sign itself, not its negation.
     pub uv_v_up: bool,
+    /// How coarsely the file stores what the checks compare (zero for floats).
+    pub quant: Quant,
+}
+
+/// Quantization steps (KHR_mesh_quantization) of the data a frame check compares, each in the
+/// units the check sees (positions as decoded, UVs after the normal texture's transform). A stored
+/// value is within half a step of the value that was quantized; the checks widen their tolerances
+/// by exactly what that explains (docs/validate.md derives each bound) and by nothing more.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Quant {
+    pub position: f64,
+    pub normal: f64,
+    pub uv: f64,
+    pub tangent: f64,
+}
+
+impl Quant {
+    /// The largest angle between a unit vector and its quantized copy: each of three components
+    /// moves by at most half a step, so the vector by `sqrt(3)/2 * step`.
+    pub fn vector_angle(step: f64) -> f64 {
+        (3f64.sqrt() / 2.0 * step).min(1.0).asin()
+    }
+
+    /// The most a quantized unit vector's length can differ from 1.
+    pub fn unit_slack(&self) -> f64 {
+        3f64.sqrt() / 2.0 * self.tangent
+    }
+
+    /// The angle the stored tangent and normal may each be off by.
+    pub fn frame_angle(&self) -> f64 {
+        Self::vector_angle(self.tangent) + Self::vector_angle(self.normal)
+    }
+
+    /// Per vertex, the angle (radians) by which the triangles around it may turn their MikkTSpace
+    /// direction because their corners were rounded, and per triangle whether rounding may have
+    /// flipped its orientation in UV space (and so its `w`).
+    ///
+    /// A triangle's tangent is the direction along which u grows; moving one corner by `e` turns
+    /// it, to first order, by at most `e / h` where `h` is the altitude from that corner, so three
+    /// corners give at most `3 e / h_min`. In UV space `e = sqrt(2)/2 * step`, in space
+    /// `e = sqrt(3)/2 * step`. Its orientation can flip only if a corner can cross the opposite
+    /// side, that is `h_min <= 2 e` in UV space. MikkTSpace averages the triangles around a
+    /// vertex, and around every other vertex at the same position, so each vertex takes the
+    /// largest turn of all of those. Empty when nothing is quantized.
+    pub fn slack(&self, positions: &[[f32; 3]], uvs: &[[f32; 2]], indices: &[u32]) -> (Vec<f64>, Vec<bool>) {
+        if self.position == 0.0 && self.uv == 0.0 {
+            return (Vec::new(), Vec::new());
+        }
+        let e_uv = 2f64.sqrt() / 2.0 * self.uv;
+        let e_p = 3f64.sqrt() / 2.0 * self.position;
+        let mut turn = vec![0.0f64; positions.len()];
+        let mut may_flip = Vec::with_capacity(indices.len() / 3);
+        for t in indices.chunks_exact(3) {
+            let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
+            let h_p = min_altitude([positions[a], positions[b], positions[c]].map(d3));
+            let h_uv = min_altitude([uvs[a], uvs[b], uvs[c]].map(|v| DVec3::new(v[0] as f64, v[1] as f64, 0.0)));
+            may_flip.push(h_uv <= 2.0 * e_uv);
+            let x = 3.0 * e_p / h_p + 3.0 * e_uv / h_uv;
+            let x = if x.is_finite() { x.min(std::f64::consts::PI) } else { std::f64::consts::PI };
+            for v in [a, b, c] {
+                turn[v] = turn[v].max(x);
+            }
+        }
+        let mut by_position: std::collections::HashMap<[u32; 3], f64> = std::collections::HashMap::new();
+        for (p, &x) in positions.iter().zip(&turn) {
+            let m = by_position.entry(p.map(f32::to_bits)).or_insert(0.0);
+            *m = m.max(x);
+        }
+        for (p, x) in positions.iter().zip(turn.iter_mut()) {
+            *x = by_position[&p.map(f32::to_bits)];
+        }
+        (turn, may_flip)
+    }
+}
+
+/// The smallest altitude of a triangle: twice its area over its longest side (0 if degenerate).
+fn min_altitude(p: [DVec3; 3]) -> f64 {
+    let area2 = (p[1] - p[0]).cross(p[2] - p[0]).length();
+    let longest = (p[1] - p[0]).length().max((p[2] - p[1]).length()).max((p[0] - p[2]).length());
+    if longest > 0.0 {
+        area2 / longest
+    } else {
+        0.0
+    }
 }
 
 /// What earlier checks already explained, so later ones skip it.
@@ -69,6 +153,9 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
     let (mut w_nf, mut w_nu, mut w_w, mut w_par, mut w_skew) =
         (Worst::default(), Worst::default(), Worst::default(), Worst::default(), Worst::default());
     let mut worst_skew_deg = 0.0f64;
+    let unit_tol = KHRONOS_UNIT_TOLERANCE.max(d.quant.unit_slack());
+    // Quantized tangents and normals each lean by up to their step's angle.
+    let ortho_cos = (ORTHO_COS.asin() + d.quant.frame_angle()).min(std::f64::consts::FRAC_PI_2).sin();
     for (v, &tv) in t.iter().enumerate() {
         let ex_v = |detail: String| Example { kind: "vertex", index: v as u64, at: None, detail };
         if !tv.iter().all(|x| x.is_finite()) {
@@ -79,7 +166,7 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
         }
         let xyz = d3([tv[0], tv[1], tv[2]]);
         let len = xyz.length();
-        if (len - 1.0).abs() > KHRONOS_UNIT_TOLERANCE {
+        if (len - 1.0).abs() > unit_tol {
             nonunit += 1;
             ex.bad_vertex[v] = true;
             w_nu.push((len - 1.0).abs(), || ex_v(format!("tangent {} has length {len:.5}", fmt_t(tv))));
@@ -106,7 +193,7 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
                     cos.min(1.0).acos().to_degrees()
                 ))
             });
-        } else if cos > ORTHO_COS {
+        } else if cos > ortho_cos {
             skew += 1;
             ex.bad_vertex[v] = true;
             let off = cos.min(1.0).asin().to_degrees();
@@ -137,7 +224,7 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
                 nonunit,
                 n,
                 "vertices",
-                format!("{nonunit} of {n} tangents are not unit length (|len - 1| > {KHRONOS_UNIT_TOLERANCE})"),
+                format!("{nonunit} of {n} tangents are not unit length (|len - 1| > {unit_tol:.5})"),
             )
             .examples(w_nu.into_examples())
         }),

@@ -1,10 +1,10 @@
 //! Runs the checks over a whole scene: each primitive (presence, frames, handedness,
 //! conformance, degenerate triangles), node transforms, and each normal-map image once.
 
-use super::frames::{self, Explained, PrimData};
+use super::frames::{self, Explained, PrimData, Quant};
 use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
 use crate::error::Result;
-use crate::scene::{Materials, PrimRef, Scene};
+use crate::scene::{dequant, Materials, PrimRef, Scene};
 use crate::tangent::apply::to_triangle_list;
 use rayon::prelude::*;
 use serde_json::Value;
@@ -20,18 +20,22 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.primitive = Some(r.primitive);
         let pj = scene.prim_json(r);
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
-        let why = if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
-            Some("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".to_string())
+        // A compressed primitive whose normal map needs frames is a warning: its frames go
+        // unchecked, and `--strict` must not pass them silently.
+        let (code, why) = if let Some(why) = crate::scene::draco::why_unreadable(scene, r) {
+            let code = if scene.normal_texcoord(r).is_some() {
+                Code::PRIMITIVE_COMPRESSED
+            } else {
+                Code::PRIMITIVE_NOT_CHECKED
+            };
+            (code, Some(why))
         } else if !(4..=6).contains(&mode) {
-            Some(format!("not triangles (mode {mode})"))
+            (Code::PRIMITIVE_NOT_CHECKED, Some(format!("not triangles (mode {mode})")))
         } else {
-            None
+            (Code::PRIMITIVE_NOT_CHECKED, None)
         };
         if let Some(why) = why {
-            s.check(
-                Code::PRIMITIVE_NOT_CHECKED,
-                Some(Finding::new(Code::PRIMITIVE_NOT_CHECKED, 1, 1, "primitives", format!("not checked: {why}"))),
-            );
+            s.check(code, Some(Finding::new(code, 1, 1, "primitives", format!("not checked: {why}"))));
             subjects.push((s, None));
             continue;
         }
@@ -48,20 +52,24 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             subjects.push((s, None));
             continue;
         }
-        // The UVs the renderer samples the map with: the texture transform's output, which is
-        // what the tangent must follow.
+        // Compared as a renderer sees them: quantized normals made unit, UVs through the transform
+        // of the texture the tangents serve (the UVs the tangent must follow).
         let need = mats.tangent_need(scene, r);
         let uv_name = format!("TEXCOORD_{}", need.as_ref().map_or(0, |n| n.need.tex_coord));
-        let transform = need.as_ref().and_then(|n| n.need.transform);
-        let uvs = p.attr(&uv_name).map(|s| match transform {
-            Some(t) => s.to_f32::<2>().into_iter().map(|uv| t.apply(uv)).collect(),
-            None => s.to_f32::<2>(),
-        });
+        let uv_t = need.as_ref().and_then(|n| n.need.transform);
+        let step = |name: &str| p.attr(name).map_or(0.0, |s| s.step() as f64);
+        let quant = Quant {
+            position: step("POSITION"),
+            normal: step("NORMAL"),
+            uv: step(&uv_name) * uv_t.as_ref().map_or(1.0, |t| t.max_stretch()),
+            tangent: step("TANGENT"),
+        };
         let d = PrimData {
             positions: p.positions(),
-            normals: p.attr("NORMAL").map(|s| s.to_f32::<3>()),
-            uvs,
+            normals: p.attr("NORMAL").map(|s| dequant::unit_normals(s).into_owned()),
+            uvs: p.attr(&uv_name).map(|s| dequant::transformed_uvs(s.as_f32(), uv_t.as_ref()).into_owned()),
             tangents: p.attr("TANGENT").map(|s| s.to_f32::<4>()),
+            quant,
             indices: p.indices,
             uv_v_up: scene.uv_v_up,
         };

@@ -33,6 +33,9 @@ fn description(code: Code) -> &'static str {
         TRIANGLE_UV_DEGENERATE => "A triangle with zero area in the normal texture's UV space.",
         TRIANGLE_SLIVER => "A needle triangle (quality below 1e-3) with unstable tangents.",
         NODE_MIRRORED => "A node shows a mesh through a negative-determinant transform (a mirrored instance).",
+        PRIMITIVE_COMPRESSED => {
+            "A primitive whose material needs tangents is Draco-compressed: its frames cannot be checked."
+        }
         PRIMITIVE_NOT_CHECKED => "A primitive the checks cannot read (not triangles, compressed, no POSITION).",
         NORMALMAP_UNREADABLE => "A material's normal-texture image could not be read or decoded.",
         NORMALMAP_Z_NEGATIVE => "Normal-map texels decode to z < 0: they point into the surface.",

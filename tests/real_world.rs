@@ -1,0 +1,324 @@
+//! Files other tools write: KHR_mesh_quantization, EXT_meshopt_compression and
+//! KHR_draco_mesh_compression from glTF-Transform and gltfpack.
+//!
+//! The small files in `fixtures/real/` (made by `fixtures/real/make.sh`) run with every `cargo
+//! test`. The full corpus (`.ci/corpus.sh`, variants of the Khronos fixtures) is found through
+//! `BUMPBAKE_CORPUS`, which `.ci/run` sets; under `CI=true` a missing corpus fails the test.
+
+mod common;
+use bumpbake::scene::dequant::{transformed_uvs, unit_normals};
+use bumpbake::tangent::mikk::{generate, Engine};
+use bumpbake::tangent::TriMesh;
+use common::*;
+use std::path::{Path, PathBuf};
+
+/// Every corner of every primitive whose material has a normal texture carries the MikkTSpace frame
+/// of the geometry a renderer decodes (quantized normals made unit, UVs through the normal
+/// texture's transform). Returns the number of corners compared.
+fn assert_mikktspace(out: &Path) -> usize {
+    let scene = load(out);
+    let mut compared = 0;
+    for r in scene.primitives() {
+        let Some(set) = scene.normal_texcoord(r) else { continue };
+        let p = bumpbake::tangent::apply::to_triangle_list(scene.primitive(r).unwrap());
+        let t = p.attr("TANGENT").unwrap_or_else(|| panic!("{}: {r:?} has a normal texture and no TANGENT", s(out)));
+        assert_eq!(t.format.component_type, bumpbake::scene::accessor::FLOAT, "tangents written as floats");
+        let t = t.to_f32::<4>();
+        let positions = p.positions();
+        let normals = unit_normals(p.attr("NORMAL").unwrap()).into_owned();
+        let uvs = p.attr(&format!("TEXCOORD_{set}")).unwrap().as_f32();
+        let uvs = transformed_uvs(uvs, scene.normal_uv_transform(r).as_ref()).into_owned();
+        let mesh = TriMesh { positions: &positions, normals: &normals, uvs: &uvs, indices: &p.indices };
+        let reference = generate(&mesh, Engine::Bevy);
+        let mut bad = 0;
+        for (c, rf) in reference.iter().enumerate() {
+            let Some(rf) = rf else { continue };
+            let stored = t[p.indices[c] as usize];
+            compared += 1;
+            // glTF UVs run v down: the stored w is the reference sign negated (the conventions).
+            if angle(stored, *rf) > 1e-4 || stored[3] != -rf[3] {
+                bad += 1;
+            }
+        }
+        assert!(bad * 1000 <= reference.len(), "{}: {bad} corners differ from MikkTSpace", s(out));
+    }
+    compared
+}
+
+/// An exit 2 is one plain line naming the file and what to do, never Rust debug text.
+fn assert_plain_refusal(o: &std::process::Output, input: &Path, must_name: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{}: {err}", s(input));
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.contains(input.file_name().unwrap().to_str().unwrap()), "names the file: {err}");
+    assert!(err.contains(must_name), "names {must_name}: {err}");
+    assert!(!err.contains("Some(") && !err.contains("{ "), "no debug text: {err}");
+}
+
+fn real(name: &str) -> PathBuf {
+    fixture(&format!("real/{name}"))
+}
+
+#[test]
+fn quantized_and_meshopt_files_get_mikktspace_tangents_on_their_decoded_geometry() {
+    let d = validated_dir("real_tangents");
+    for name in [
+        "mirror_small.quantize.glb",
+        "mirror_small.meshopt.glb",
+        "mirror_small.gltfpack.glb",
+        "mirror_small.gltfpack-c.glb",
+    ] {
+        let out = d.join(name);
+        let o = run_ok(&["tangents", s(&real(name)), "-o", s(&out), "--overwrite", "--json"]);
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(report["generated"], 1, "{name}: {report}");
+        assert!(assert_mikktspace(&out) > 500, "{name}: most corners compared");
+        let json = load(&out).json;
+        let used = json["extensionsUsed"].to_string();
+        assert!(!used.contains("EXT_meshopt_compression"), "{name}: written uncompressed: {used}");
+        if name.contains("meshopt") || name.contains("-c") {
+            assert!(report.to_string().contains("EXT_meshopt_compression"), "the report says it was decoded");
+        }
+        // Quantized attributes keep their types; POSITION keeps integer bounds.
+        let pos = json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize;
+        let acc = &json["accessors"][pos];
+        assert_ne!(acc["componentType"], 5126, "{name}: POSITION stays quantized");
+        assert!(acc["min"].as_array().unwrap().iter().all(|x| x.is_i64() || x.is_u64()), "{name}: {acc}");
+    }
+}
+
+#[test]
+fn authored_tangents_carried_through_quantization_pass_strict_validation() {
+    for name in
+        ["mirror_small.glb", "mirror_small.quantize.glb", "mirror_small.gltfpack.glb", "mirror_small.gltfpack-c.glb"]
+    {
+        let o = run(&["validate", "--strict", "--format", "json", s(&real(name))]);
+        assert_eq!(o.status.code(), Some(0), "{name}: {}", String::from_utf8_lossy(&o.stdout));
+    }
+}
+
+/// `input` with every stored tangent turned by `turn_deg` about its normal and `w` multiplied by
+/// `flip`, written to `out`.
+fn spoil_tangents(input: &Path, out: &Path, turn_deg: f32, flip: f32) {
+    let mut scene = load(input);
+    for r in scene.primitives() {
+        let mut p = scene.primitive(r).unwrap();
+        let (Some(n), Some(t)) = (p.attr("NORMAL"), p.attr("TANGENT")) else { continue };
+        let n = unit_normals(n).into_owned();
+        let changed: Vec<[f32; 4]> = t
+            .to_f32::<4>()
+            .iter()
+            .zip(&n)
+            .map(|(t, n)| {
+                let q = glam::Quat::from_axis_angle(glam::Vec3::from(*n), turn_deg.to_radians());
+                let v = q * glam::Vec3::new(t[0], t[1], t[2]).normalize();
+                [v.x, v.y, v.z, t[3] * flip]
+            })
+            .collect();
+        p.set_attr("TANGENT", bumpbake::scene::Stream::from_f32("VEC4", &changed));
+        scene.set_primitive(r, &p);
+    }
+    let (files, _) = bumpbake::scene::write(&scene, out, &Default::default()).unwrap();
+    files.commit().unwrap();
+}
+
+/// Validating a spoilt copy of `input` fails with `code`.
+fn assert_spoilt_frames_fail(input: &Path, d: &Path) {
+    let stem = input.file_stem().unwrap().to_str().unwrap();
+    for (name, turn, flip, code) in
+        [("rotated", 20f32, 1.0, "TANGENT_MIKK_ANGLE"), ("flipped", 0.0, -1.0, "TANGENT_W_MISMATCH_UV")]
+    {
+        let f = d.join(format!("{stem}.{name}.glb"));
+        spoil_tangents(input, &f, turn, flip);
+        let o = run(&["validate", "--format", "json", s(&f)]);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(o.status.code(), Some(1), "{stem} {name}: {out}");
+        assert!(out.contains(code), "{stem} {name}: {code} expected in {out}");
+    }
+}
+
+#[test]
+fn a_rotated_or_flipped_frame_in_a_quantized_file_is_still_an_error() {
+    // Quantization explains well under a degree on most triangles of this mesh, and no sign.
+    assert_spoilt_frames_fail(&real("mirror_small.gltfpack.glb"), &scratch_dir("real_rotated"));
+}
+
+#[test]
+fn draco_primitives_that_need_tangents_are_refused_with_the_way_out() {
+    let input = real("mirror_small.draco.glb");
+    let d = scratch_dir("real_draco");
+    for args in [
+        vec!["tangents", s(&input), "-o", s(&d.join("t.glb"))],
+        vec!["tangents", s(&input), "-o", s(&d.join("t.glb")), "--overwrite"],
+        vec!["bake", s(&input), "-o", s(&d.join("b.glb"))],
+        vec!["preview", s(&input), "-o", s(&d.join("p.png"))],
+    ] {
+        let o = run(&args);
+        assert_plain_refusal(&o, &input, "KHR_draco_mesh_compression");
+        assert!(String::from_utf8_lossy(&o.stderr).contains("gltf-transform"), "names the way out");
+        assert!(std::fs::read_dir(&d).unwrap().next().is_none(), "{args:?}: nothing written");
+    }
+    // validate cannot check its frames: a warning, so `--strict` does not pass it silently.
+    let o = run(&["validate", "--strict", "--format", "json", s(&input)]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(out.contains("PRIMITIVE_COMPRESSED") && out.contains("gltf-transform"), "{out}");
+    // Without --strict it passes, saying what it did not check.
+    assert_eq!(run(&["validate", s(&input)]).status.code(), Some(0));
+}
+
+/// The files `.ci/corpus.sh` made, or `None` (with a note) outside CI when there are none.
+fn corpus() -> Option<Vec<PathBuf>> {
+    let ci = std::env::var("CI").map(|v| v == "true").unwrap_or(false);
+    let Some(dir) = std::env::var_os("BUMPBAKE_CORPUS") else {
+        assert!(!ci, "CI=true but BUMPBAKE_CORPUS is not set: .ci/run makes the corpus with .ci/corpus.sh");
+        eprintln!("BUMPBAKE_CORPUS is not set: the corpus test has nothing to run (bash .ci/corpus.sh DIR)");
+        return None;
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("BUMPBAKE_CORPUS={}: {e}", PathBuf::from(&dir).display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "glb" || e == "gltf"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 14, "the corpus has {} files; .ci/corpus.sh makes 14", files.len());
+    Some(files)
+}
+
+#[test]
+fn every_command_on_every_corpus_file_succeeds_or_says_why() {
+    let Some(files) = corpus() else { return };
+    let d = validated_dir("corpus");
+    let scratch = scratch_dir("corpus");
+    for f in &files {
+        let stem = f.file_stem().unwrap().to_str().unwrap();
+        let draco = stem.contains("draco");
+        for (tag, extra) in [("kept", None), ("overwrite", Some("--overwrite"))] {
+            let out = d.join(format!("{stem}.tangents-{tag}.glb"));
+            let mut args = vec!["tangents", s(f), "-o", s(&out), "-q"];
+            args.extend(extra);
+            let o = run(&args);
+            if draco {
+                assert_plain_refusal(&o, f, "KHR_draco_mesh_compression");
+                continue;
+            }
+            assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+            if extra.is_some() {
+                assert!(assert_mikktspace(&out) > 0, "{stem}");
+            }
+        }
+        let out = d.join(format!("{stem}.bake.glb"));
+        let o = run(&["bake", s(f), "-o", s(&out), "-q"]);
+        match o.status.code() {
+            Some(0) => {}
+            _ if draco => assert_plain_refusal(&o, f, "KHR_draco_mesh_compression"),
+            // Images another helper's decoder may not read yet: a plain refusal naming the format.
+            _ => assert_plain_refusal(&o, f, ""),
+        }
+        let png = scratch.join(format!("{stem}.png"));
+        let o = run(&["preview", s(f), "-o", s(&png)]);
+        match o.status.code() {
+            Some(0) => assert!(png.exists()),
+            _ if draco => assert_plain_refusal(&o, f, "KHR_draco_mesh_compression"),
+            _ => assert_plain_refusal(&o, f, ""),
+        }
+        let o = run(&["validate", "--format", "json", s(f)]);
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        if draco {
+            assert!(report.to_string().contains("KHR_draco_mesh_compression"), "{stem}: says what it did not check");
+        }
+        run_ok(&["inspect", s(f)]);
+        // Quantized authored frames pass strictly; turned or flipped ones still fail.
+        if ["quantize", "gltfpack", "meshopt"].iter().any(|k| stem.contains(k)) {
+            let o = run(&["validate", "--strict", s(f)]);
+            assert_eq!(o.status.code(), Some(0), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
+            assert_spoilt_frames_fail(f, &scratch);
+        }
+    }
+}
+
+#[test]
+fn preview_draws_quantized_files_as_their_float_original() {
+    // gltfpack's UVs only land on the textures through the KHR_texture_transform it adds; the
+    // quantized file must render like the float one it was made from.
+    let d = scratch_dir("real_preview");
+    let render = |name: &str| {
+        let out = d.join(format!("{name}.png"));
+        run_ok(&["preview", s(&real(name)), "-o", s(&out), "--size", "128x128"]);
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let float = render("mirror_small.glb");
+    for name in ["mirror_small.gltfpack.glb", "mirror_small.quantize.glb", "mirror_small.gltfpack-c.glb"] {
+        let q = render(name);
+        let diff: u64 = float.as_raw().iter().zip(q.as_raw()).map(|(a, b)| a.abs_diff(*b) as u64).sum();
+        let mean = diff as f64 / float.as_raw().len() as f64;
+        assert!(mean < 2.0, "{name}: mean difference {mean:.2} of 255 from the float original");
+    }
+}
+
+#[test]
+fn position_accessors_leave_with_bounds_even_when_the_input_had_none() {
+    let mut g = Gltf::new();
+    let p = g.floats(&[[0.0, 0.0, 0.0], [2.0, 0.0, -1.0], [0.0, 3.0, 0.5]], Some(34962));
+    let n = g.floats(&[[0.0, 0.0, 1.0]; 3], Some(34962));
+    g.mesh(serde_json::json!({ "attributes": { "POSITION": p, "NORMAL": n } }));
+    for key in ["min", "max"] {
+        g.json["accessors"][p].as_object_mut().unwrap().remove(key);
+    }
+    let input = scratch_dir("real_bounds").join("no_bounds.glb");
+    g.write_glb(&input);
+    assert!(load(&input).json["accessors"][p].get("min").is_none());
+    let out = validated_dir("real_bounds").join("bounds.glb");
+    run_ok(&["tangents", s(&input), "-o", s(&out), "-q"]);
+    let acc = &load(&out).json["accessors"][0];
+    assert_eq!(acc["min"], serde_json::json!([0.0, 0.0, -1.0]));
+    assert_eq!(acc["max"], serde_json::json!([2.0, 3.0, 0.5]));
+}
+
+#[test]
+fn a_rotated_texture_transform_turns_the_tangent_with_it() {
+    // A flat quad with u along +x and v along +y. The normal texture turns its UVs by 90°
+    // (u' = v, v' = -u), so the map's +x runs along +y on the surface: that is the tangent.
+    for (rotation, expected) in [(0.0, [1.0, 0.0, 0.0]), (std::f64::consts::FRAC_PI_2, [0.0, 1.0, 0.0])] {
+        let mut g = Gltf::new();
+        let p = g.floats(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]], Some(34962));
+        let n = g.floats(&[[0.0, 0.0, 1.0]; 4], Some(34962));
+        let t = g.floats(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], Some(34962));
+        let i = g.indices(&[0, 1, 2, 0, 2, 3]);
+        let tex = g.texture();
+        let m = g.material(serde_json::json!({
+            "normalTexture": { "index": tex, "extensions": { "KHR_texture_transform": { "rotation": rotation } } }
+        }));
+        g.json["extensionsUsed"] = serde_json::json!(["KHR_texture_transform"]);
+        g.mesh(serde_json::json!({ "attributes": { "POSITION": p, "NORMAL": n, "TEXCOORD_0": t }, "indices": i, "material": m }));
+        let input = scratch_dir("real_rotated_uv").join("quad.glb");
+        g.write_glb(&input);
+        let out = validated_dir(&format!("real_rotated_uv_{}", rotation != 0.0)).join("quad.glb");
+        run_ok(&["tangents", s(&input), "-o", s(&out), "-q"]);
+        for tan in corner_attr::<4>(&load(&out), P0, "TANGENT") {
+            let d: f32 = (0..3).map(|k| tan[k] * expected[k]).sum();
+            assert!(d > 0.9999, "rotation {rotation}: tangent {tan:?}, expected {expected:?}");
+            assert_eq!(tan[3], -1.0);
+        }
+    }
+}
+
+#[test]
+fn valid_quantized_tangents_are_kept_as_they_are() {
+    let d = validated_dir("real_kept");
+    for name in ["mirror_small.gltfpack.glb", "mirror_small.quantize.glb"] {
+        let out = d.join(name);
+        let o = run_ok(&["tangents", s(&real(name)), "-o", s(&out), "--json"]);
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(report["kept"], 1, "{name}: {report}");
+        let (a, b) = (load(&real(name)), load(&out));
+        let tangent = |sc: &bumpbake::scene::Scene| sc.primitive(P0).unwrap().attr("TANGENT").unwrap().clone();
+        let (ta, tb) = (tangent(&a), tangent(&b));
+        assert_eq!(
+            (ta.format, ta.data),
+            (tb.format, tb.data),
+            "{name}: the authored quantized tangents, byte for byte"
+        );
+    }
+}
