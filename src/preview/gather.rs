@@ -275,10 +275,15 @@ impl Cx<'_> {
         let Some(ti) = info.get("index").and_then(|i| i.as_u64()) else { return Ok(None) };
         let tj =
             s.json.pointer(&format!("/textures/{ti}")).ok_or_else(|| s.err(format!("texture {ti} does not exist")))?;
-        let Some(img) = tj.get("source").and_then(|i| i.as_u64()).map(|i| i as usize) else {
-            self.notes.push(format!("texture {ti} has no PNG/JPEG source; drawn without it"));
+        let choice = s.texture_image_to_decode(ti as usize)?;
+        self.notes.extend(choice.note(ti as usize));
+        let Some((chosen, bytes)) = choice.chosen else {
+            if choice.passed_over.is_empty() {
+                self.notes.push(format!("texture {ti} has no image; drawn without it"));
+            }
             return Ok(None);
         };
+        let img = chosen.image;
         let sampler = Sampler::from_json(
             tj.get("sampler").and_then(|i| i.as_u64()).and_then(|i| s.json.pointer(&format!("/samplers/{i}"))),
         );
@@ -297,7 +302,6 @@ impl Cx<'_> {
         let texture = match self.textures.get(&(img, srgb)) {
             Some(t) => t.clone(),
             None => {
-                let bytes = image_bytes(s, img)?;
                 let t = Arc::new(Texture::decode(&bytes, srgb).map_err(|e| s.err(format!("image {img}: {e}")))?);
                 self.textures.insert((img, srgb), t.clone());
                 t
@@ -305,30 +309,6 @@ impl Cx<'_> {
         };
         Ok(Some(TexRef { texture, sampler, texcoord: texcoord as u32 }))
     }
-}
-
-/// The encoded bytes of `images[img]`, from a URI (data or file) or a buffer view.
-fn image_bytes(s: &Scene, img: usize) -> Result<Vec<u8>> {
-    let ij = s.json.pointer(&format!("/images/{img}")).ok_or_else(|| s.err(format!("image {img} does not exist")))?;
-    if let Some(uri) = ij.get("uri").and_then(|u| u.as_str()) {
-        return crate::scene::uri::read(uri, &s.base_dir, &s.source, s.allow_outside);
-    }
-    let bv = ij
-        .get("bufferView")
-        .and_then(|b| b.as_u64())
-        .ok_or_else(|| s.err(format!("image {img} has neither uri nor bufferView")))?;
-    let v = s
-        .json
-        .pointer(&format!("/bufferViews/{bv}"))
-        .ok_or_else(|| s.err(format!("image {img}: bufferView {bv} does not exist")))?;
-    let b = v.get("buffer").and_then(|b| b.as_u64()).unwrap_or(0) as usize;
-    let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-    let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-    s.buffers
-        .get(b)
-        .and_then(|buf| buf.get(off..off.checked_add(len)?))
-        .map(|x| x.to_vec())
-        .ok_or_else(|| s.err(format!("image {img}: bufferView {bv} lies outside its buffer")))
 }
 
 /// Every (mesh, world matrix) the scene shows.

@@ -10,7 +10,7 @@ pub mod accessor;
 mod compact;
 mod gltf_read;
 mod gltf_write;
-pub mod image_limits;
+pub mod image;
 mod obj;
 pub mod uri;
 pub mod weld;
