@@ -100,6 +100,20 @@ impl Kind {
         }
     }
 
+    /// The decoded format a file name's extension claims, if any (for messages only: formats are
+    /// told by their bytes).
+    pub fn from_extension(path: &std::path::Path) -> Option<Kind> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "png" => Some(Kind::Png),
+            "jpg" | "jpeg" => Some(Kind::Jpeg),
+            "webp" => Some(Kind::WebP),
+            "tif" | "tiff" => Some(Kind::Tiff),
+            "exr" => Some(Kind::OpenExr),
+            _ => None,
+        }
+    }
+
     /// The format's name, in words.
     pub fn name(self) -> &'static str {
         match self {
@@ -230,8 +244,20 @@ pub fn decode(bytes: &[u8]) -> Result<DynamicImage, String> {
 /// Decodes an image after checking its header against `limits`.
 pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
     dimensions_within(bytes, limits)?;
+    if Kind::sniff(bytes) == Kind::Jpeg && !jpeg_is_whole(bytes) {
+        return Err("cannot decode as JPEG: the file ends early (truncated)".into());
+    }
     let (kind, r) = reader(bytes, Cursor::new(bytes))?;
     decode_reader(kind, r, limits)
+}
+
+/// Whether a JPEG's last scan is followed by its end-of-image marker. The JPEG decoder fills the
+/// missing part of a truncated file with grey and reports success; a truncated normal or height
+/// map must be refused instead. Entropy-coded data cannot hold `FF D9` (an `FF` byte there is
+/// stuffed as `FF 00`), so the marker after the last start-of-scan is the image's real end.
+fn jpeg_is_whole(b: &[u8]) -> bool {
+    let last_scan = b.windows(2).rposition(|w| w == [0xFF, 0xDA]);
+    last_scan.is_some_and(|s| b[s..].windows(2).any(|w| w == [0xFF, 0xD9]))
 }
 
 /// Decodes from a reader whose header has been recognised; the size is checked from the header
@@ -257,8 +283,20 @@ pub fn read_file(path: &std::path::Path, max_pixels: u64) -> crate::error::Resul
     let mut head = Vec::with_capacity(16);
     (&mut file).take(16).read_to_end(&mut head).map_err(open)?;
     file.rewind().map_err(open)?;
+    if Kind::sniff(&head) == Kind::Unknown {
+        if let Some(named) = Kind::from_extension(path) {
+            let m = format!("cannot decode as {0}: the file does not start as a {0} file does", named.name());
+            return Err(Error::input(path, m));
+        }
+    }
+    let limits = Limits::file(max_pixels);
+    if Kind::sniff(&head) == Kind::Jpeg {
+        // Whole in memory, to check its end: JPEGs are small beside their pixels.
+        let bytes = std::fs::read(path).map_err(open)?;
+        return decode_within(&bytes, &limits).map_err(|m| Error::input(path, m));
+    }
     let (kind, r) = reader(&head, file).map_err(|m| Error::input(path, m))?;
-    decode_reader(kind, r, &Limits::file(max_pixels)).map_err(|m| Error::input(path, m))
+    decode_reader(kind, r, &limits).map_err(|m| Error::input(path, m))
 }
 
 /// Whether the file starts like a PNG (read from its first bytes only).
@@ -402,8 +440,11 @@ mod tests {
         let e = decode(b"GIF89a\x01\x00\x01\x00").unwrap_err();
         assert!(e.starts_with("a GIF image"), "{e}");
         let jpeg = encoded(ImageFormat::Jpeg);
-        let e = decode(&jpeg[..jpeg.len() / 3]).unwrap_err();
-        assert!(e.starts_with("cannot decode as JPEG"), "{e}");
+        // Cut anywhere in its scan, a JPEG still "decodes" (the rest grey): it must be refused.
+        for cut in [jpeg.len() / 3, jpeg.len() - 2] {
+            let e = decode(&jpeg[..cut]).unwrap_err();
+            assert!(e.starts_with("cannot decode as JPEG"), "{e}");
+        }
         let webp = encoded(ImageFormat::WebP);
         let e = decode(&webp[..webp.len() - 10]).unwrap_err();
         assert!(e.starts_with("cannot decode as WebP"), "{e}");
