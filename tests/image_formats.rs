@@ -209,3 +209,46 @@ fn truncated_jpeg_and_webp_are_refused_in_words() {
         assert!(!out.exists());
     }
 }
+
+/// preview draws a KTX2 texture's PNG fallback and says so; a KTX2-only texture is drawn without,
+/// with a note naming the image; a WebP-only texture is drawn with its map.
+#[test]
+fn preview_names_ktx2_and_draws_what_it_can() {
+    let d = scratch_dir("formats_preview");
+    let ktx2 = json!({ "uri": data_uri("image/ktx2", b"\xABKTX 20\xBB\r\n\x1a\n\0\0\0\0") });
+    let png = json!({ "uri": data_uri("image/png", &encoded(&saddle(16, false), ImageFormat::Png)) });
+    let webp = json!({ "uri": data_uri("image/webp", &encoded(&saddle(16, false), ImageFormat::WebP)) });
+    let basisu = |source: Option<u64>| {
+        let mut t = json!({ "extensions": { "KHR_texture_basisu": { "source": 0 } } });
+        if let Some(s) = source {
+            t["source"] = json!(s);
+        }
+        t
+    };
+    let cases = [
+        ("fallback", vec![ktx2.clone(), png], basisu(Some(1)), Some("image 1 is used instead")),
+        ("ktx2_only", vec![ktx2], basisu(None), Some("the texture is left out")),
+        ("webp_only", vec![webp], json!({ "extensions": { "EXT_texture_webp": { "source": 0 } } }), None),
+    ];
+    let mut shaded = Vec::new();
+    for (name, images, texture, note) in cases {
+        let mut g = Gltf::new();
+        normal_mapped_quad(&mut g, texture);
+        g.json["images"] = json!(images);
+        let path = d.join(format!("{name}.glb"));
+        g.write_glb(&path);
+        let img = d.join(format!("{name}.png"));
+        let o = run_ok(&["preview", s(&path), "-o", s(&img), "--size", "32x32", "--light", "dir:-1,-1,-1"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        match note {
+            Some(n) => {
+                assert!(err.contains("image 0 (KTX2, KHR_texture_basisu) not decoded") && err.contains(n), "{err}")
+            }
+            None => assert!(!err.contains("not decoded") && !err.contains("without"), "{err}"),
+        }
+        shaded.push(std::fs::read(&img).unwrap());
+    }
+    // The PNG fallback and the lossless WebP are the same map: the same picture.
+    assert_eq!(shaded[0], shaded[2]);
+    assert_ne!(shaded[0], shaded[1], "without the map the quad is shaded flat");
+}
