@@ -18,6 +18,9 @@ pub(super) fn needed(p: &Primitive, uv_name: &str) -> bool {
     p.targets.iter().flatten().any(|(n, _)| matches!(n.as_str(), "POSITION" | "NORMAL" | "TANGENT") || n == uv_name)
 }
 
+/// Positions, UVs and normals of a morphed mesh, and its index list.
+type Streams<'a> = (Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[f32; 3]>, &'a [u32]);
+
 /// The base mesh as the frames saw it.
 pub(super) struct Base<'a> {
     /// The frame of each corner (output `w` convention).
@@ -54,27 +57,27 @@ pub(super) fn deltas(
                 Some(d) => uv.iter().zip(d).map(|(a, b)| [a[0] + b[0], a[1] + b[1]]).collect(),
                 None => uv.clone(),
             };
-            let (positions, uvs, normals, idx): (Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[f32; 3]>, &[u32]) =
-                if base.generated_normals {
-                    let cp = p.indices.iter().map(|&i| mpos[i as usize]).collect();
-                    let cu = p.indices.iter().map(|&i| muv[i as usize]).collect();
-                    (cp, cu, base.normals.to_vec(), &corner_ids)
-                } else {
-                    let dn: Option<Vec<[f32; 3]>> = find("NORMAL").map(|s| s.to_f32());
-                    let normals = match &dn {
-                        Some(d) => base
-                            .normals
-                            .iter()
-                            .zip(d)
-                            .map(|(a, b)| {
-                                let m = Vec3::from(*a) + Vec3::from(*b);
-                                m.try_normalize().unwrap_or(m).to_array()
-                            })
-                            .collect(),
-                        None => base.normals.to_vec(),
-                    };
-                    (mpos, muv, normals, &p.indices)
+            // Corner-wise where bumpbake made flat normals (as the base frames were), else by vertex.
+            let (positions, uvs, normals, idx): Streams = if base.generated_normals {
+                let cp = p.indices.iter().map(|&i| mpos[i as usize]).collect();
+                let cu = p.indices.iter().map(|&i| muv[i as usize]).collect();
+                (cp, cu, base.normals.to_vec(), &corner_ids)
+            } else {
+                let dn: Option<Vec<[f32; 3]>> = find("NORMAL").map(|s| s.to_f32());
+                let normals = match &dn {
+                    Some(d) => base
+                        .normals
+                        .iter()
+                        .zip(d)
+                        .map(|(a, b)| {
+                            let m = Vec3::from(*a) + Vec3::from(*b);
+                            m.try_normalize().unwrap_or(m).to_array()
+                        })
+                        .collect(),
+                    None => base.normals.to_vec(),
                 };
+                (mpos, muv, normals, &p.indices)
+            };
             let mesh = TriMesh { positions: &positions, normals: &normals, uvs: &uvs, indices: idx };
             let mut frames = generate_with_stack(&mesh, engine);
             if !uv_v_up {
