@@ -338,16 +338,19 @@ impl super::Scene {
     }
 
     /// The image of `texture` to decode, with its bytes: the first of [`Self::texture_images`]
-    /// in a format bumpbake decodes. Also returns the images passed over, with their formats, so
+    /// not in a format bumpbake knows and does not decode. Also returns the images passed over, with their formats, so
     /// that callers can say what was not read.
     pub fn texture_image_to_decode(&self, texture: usize) -> crate::error::Result<TextureChoice> {
         let mut choice = TextureChoice::default();
         for ti in self.texture_images(texture) {
             let bytes = self.image_bytes(ti.image)?;
+            // Bytes in no format at all are a broken image, for the decoder to refuse: only
+            // formats known and not decoded (KTX2, AVIF, ...) are passed over.
             let kind = Kind::sniff(&bytes);
-            if choice.chosen.is_none() && kind.is_decoded() {
+            let readable = kind.is_decoded() || kind == Kind::Unknown;
+            if choice.chosen.is_none() && readable {
                 choice.chosen = Some((ti, bytes));
-            } else if !kind.is_decoded() {
+            } else if !readable {
                 choice.passed_over.push((ti, kind));
             }
         }
