@@ -213,6 +213,36 @@ pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Result<(u32, u32), St
     Ok((w, h))
 }
 
+/// What an image's header says, in words.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Header {
+    pub kind: Kind,
+    pub width: u32,
+    pub height: u32,
+    /// `grey`, `grey+alpha`, `RGB` or `RGBA`.
+    pub colour: &'static str,
+    pub bits_per_channel: u16,
+}
+
+/// Reads only the header: format, size and sample layout. Nothing is decoded and the size is not
+/// checked against the limits (describing a huge image is fine; decoding it is not).
+pub fn header(bytes: &[u8]) -> Result<Header, String> {
+    let (kind, mut r) = reader(bytes, Cursor::new(bytes))?;
+    let mut header_only = image::Limits::default();
+    header_only.max_alloc = Some(MAX_ALLOC);
+    r.limits(header_only);
+    let decoder = r.into_decoder().map_err(|e| describe(kind, e))?;
+    let (width, height) = decoder.dimensions();
+    let ct = decoder.color_type();
+    let colour = match (ct.has_color(), ct.has_alpha()) {
+        (false, false) => "grey",
+        (false, true) => "grey+alpha",
+        (true, false) => "RGB",
+        (true, true) => "RGBA",
+    };
+    Ok(Header { kind, width, height, colour, bits_per_channel: ct.bits_per_pixel() / ct.channel_count() as u16 })
+}
+
 /// Refuses empty images and those past the texture limits.
 pub fn check_size(w: u32, h: u32) -> Result<(), String> {
     check_size_within(w, h, &Limits::TEXTURE)
@@ -426,6 +456,8 @@ mod tests {
         {
             let bytes = encoded(format);
             assert_eq!(Kind::sniff(&bytes), kind);
+            let h = header(&bytes).unwrap();
+            assert_eq!((h.kind, h.width, h.height, h.colour, h.bits_per_channel), (kind, 8, 8, "RGB", 8));
             let img = decode(&bytes).unwrap().to_rgb8();
             assert_eq!(img.dimensions(), (8, 8));
             // JPEG is lossy: within a few steps of the source; the others exactly.
