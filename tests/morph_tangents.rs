@@ -117,3 +117,33 @@ fn deltas_follow_the_seam_split() {
         assert!(close(delta[c], want, 2e-6), "corner {c}: {:?}, expected {want:?}", delta[c]);
     }
 }
+
+/// Without NORMAL, bumpbake writes the flat normals a client would make; the morphed frames use
+/// those same normals (the file gives no NORMAL delta), so a turn about Z still gives the closed form.
+#[test]
+fn targets_of_a_primitive_without_normals() {
+    let d = scratch_dir("morph_flat_in");
+    let v = validated_dir("morph_flat");
+    let (pos, _, uv, idx) = grid(2);
+    let a = 1.0f32;
+    let rot_z: Vec<[f32; 3]> = pos
+        .iter()
+        .map(|p| [p[0] * a.cos() - p[1] * a.sin() - p[0], p[0] * a.sin() + p[1] * a.cos() - p[1], 0.0])
+        .collect();
+    let mut g = Gltf::new();
+    let attrs = json!({ "POSITION": g.floats(&pos, Some(34962)), "TEXCOORD_0": g.floats(&uv, Some(34962)) });
+    let targets = json!([{ "POSITION": g.floats(&rot_z, Some(34962)) }]);
+    let i = g.indices(&idx);
+    let tex = g.texture();
+    let m = g.material(json!({ "normalTexture": { "index": tex } }));
+    g.mesh(json!({ "attributes": attrs, "indices": i, "material": m, "targets": targets }));
+    let input = d.join("flat.glb");
+    g.write_glb(&input);
+    let out = v.join("flat.glb");
+    run_ok(&["tangents", s(&input), "-o", s(&out), "-q"]);
+    let scene = load(&out);
+    let want = [a.cos() - 1.0, a.sin(), 0.0];
+    for (c, t) in target_corners::<3>(&scene, 0, "TANGENT").iter().enumerate() {
+        assert!(close(*t, want, 2e-6), "corner {c}: {t:?}, expected {want:?}");
+    }
+}
