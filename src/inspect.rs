@@ -181,19 +181,16 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
         Ok(bytes) => {
             info.bytes = bytes.len();
             // Only the header is read: a file claiming a huge size costs nothing here.
-            use image::ImageDecoder;
-            let reader = image::ImageReader::new(std::io::Cursor::new(&bytes)).with_guessed_format();
-            match reader.map_err(|e| e.to_string()).and_then(|r| {
-                info.format = r.format().map(|f| format!("{f:?}").to_lowercase());
-                r.into_decoder().map_err(|e| e.to_string())
-            }) {
-                Ok(dec) => {
-                    let (w, h) = dec.dimensions();
-                    let ct = dec.color_type();
-                    info.width = Some(w);
-                    info.height = Some(h);
-                    info.color = Some(format!("{ct:?}"));
-                    info.bits_per_channel = Some(ct.bits_per_pixel() / ct.channel_count() as u16);
+            let kind = crate::scene::image::Kind::sniff(&bytes);
+            if kind != crate::scene::image::Kind::Unknown {
+                info.format = Some(kind.name().to_ascii_lowercase());
+            }
+            match crate::scene::image::header(&bytes) {
+                Ok(h) => {
+                    info.width = Some(h.width);
+                    info.height = Some(h.height);
+                    info.color = Some(h.colour.to_string());
+                    info.bits_per_channel = Some(h.bits_per_channel);
                 }
                 Err(e) => info.error = Some(e),
             }

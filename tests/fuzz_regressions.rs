@@ -40,6 +40,6 @@ fn obj_read_regressions() {
 #[test]
 fn image_decode_regressions() {
     for f in inputs("image_decode") {
-        let _ = bumpbake::scene::image_limits::decode(&std::fs::read(&f).unwrap());
+        let _ = bumpbake::scene::image::decode(&std::fs::read(&f).unwrap());
     }
 }

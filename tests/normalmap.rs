@@ -425,7 +425,7 @@ fn unusable_input_exits_2_with_one_line_and_writes_nothing() {
     assert_refused(&["normalmap", p(&garbage), "-o", p(&out)], &garbage, "cannot decode", &out);
     let text = d.path("notes.txt");
     std::fs::write(&text, "hello").unwrap();
-    assert_refused(&["normalmap", p(&text), "-o", p(&out)], &text, "not a PNG, TIFF or EXR", &out);
+    assert_refused(&["normalmap", p(&text), "-o", p(&out)], &text, "not an image in a format bumpbake reads", &out);
     let named = d.path("notes.png");
     std::fs::write(&named, "hello").unwrap();
     assert_refused(&["normalmap", p(&named), "-o", p(&out)], &named, "cannot decode as PNG", &out);

@@ -1,11 +1,11 @@
 #![no_main]
 //! Image bytes through the guarded decoder every command that reads pixels uses.
-use bumpbake::scene::image_limits;
+use bumpbake::scene::image as guarded;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(img) = image_limits::decode(data) {
+    if let Ok(img) = guarded::decode(data) {
         assert!(img.width() > 0 && img.height() > 0);
-        assert!(img.width() as u64 * img.height() as u64 <= image_limits::MAX_PIXELS);
+        assert!(img.width() as u64 * img.height() as u64 <= guarded::MAX_PIXELS);
     }
 });

@@ -84,8 +84,21 @@ pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -
         None => detected_dx && confident,
     };
     let check = ConventionCheck { detected: detected.describe().into(), confidence, converted: is_dx };
-    if !is_dx {
+    let kind = crate::scene::image::Kind::sniff(&bytes);
+    let core = matches!(kind, crate::scene::image::Kind::Png | crate::scene::image::Kind::Jpeg);
+    if !is_dx && core {
+        // PNG and JPEG are glTF's own image formats: embedded as given, byte for byte.
         return Ok((bytes, check));
+    }
+    if !is_dx {
+        // WebP, TIFF and OpenEXR are not core glTF images: stored as PNG, 16-bit for float maps.
+        let img = match img {
+            i @ (image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)) => {
+                image::DynamicImage::ImageRgb16(i.to_rgb16())
+            }
+            i => i,
+        };
+        return Ok((encode(img).map_err(|e| Error::output(path, e))?, check));
     }
     // Flip green: n.y -> -n.y is c -> max - c exactly, so nothing else moves.
     let out = match img {
@@ -113,14 +126,15 @@ pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -
 
 fn encode(img: image::DynamicImage) -> std::result::Result<Vec<u8>, String> {
     let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| e.to_string())?;
+    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| format!("cannot encode as PNG: {e}"))?;
     Ok(out.into_inner())
 }
 
-/// Gives material `m` the normal map in `png` (as a new image and texture) from UV set 0,
-/// sampled like its base colour texture.
+/// Gives material `m` the normal map in `png` (PNG or JPEG bytes, as a new image and texture)
+/// from UV set 0, sampled like its base colour texture.
 pub fn attach(scene: &mut Scene, m: usize, png: &[u8], name: &str) {
-    let img = scene.push_image(png, "image/png", Some(name));
+    let jpeg = crate::scene::image::Kind::sniff(png) == crate::scene::image::Kind::Jpeg;
+    let img = scene.push_image(png, if jpeg { "image/jpeg" } else { "image/png" }, Some(name));
     let sampler = scene.materials().get(m).and_then(|m| m.texture(Slot::BaseColor)).and_then(|t| t.sampler);
     let t = scene.push_texture(img, sampler);
     scene.set_normal_texture(m, t);

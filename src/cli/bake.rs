@@ -16,10 +16,10 @@ use std::path::{Path, PathBuf};
 pub struct Args {
     #[command(flatten)]
     pub io: super::report::MeshIo,
-    /// Height map to convert into the normal map.
+    /// Height map to convert into the normal map (PNG, JPEG, WebP, TIFF or EXR).
     #[arg(long, conflicts_with = "normal")]
     pub height: Option<PathBuf>,
-    /// Normal map to attach (a DirectX one is converted to glTF's +Y).
+    /// Normal map to attach (PNG/JPEG kept, WebP/TIFF/EXR stored as PNG; DirectX converted to glTF's +Y).
     #[arg(long)]
     pub normal: Option<PathBuf>,
     /// The material that gets the map (default: those with a bump map, or the only one).

@@ -21,7 +21,7 @@ pub enum Alpha {
   bumpbake normalmap terrain16.png -o terrain_n.png --bits 16 --height-range 0.05 --texel-size 0.001 --wrap repeat
   bumpbake normalmap depth.exr -o n.png --invert --convention directx --alpha height --filter spectral")]
 pub struct Args {
-    /// Height maps: PNG (8/16-bit gray, gray+alpha, RGB, RGBA), TIFF or EXR.
+    /// Height maps: PNG (8/16-bit gray, gray+alpha, RGB, RGBA), JPEG, WebP, TIFF or EXR.
     #[arg(required = true)]
     pub heights: Vec<PathBuf>,
     /// Normal map to write (one input): .png (8 or 16-bit), .tif, or .exr (32-bit float).

@@ -5,7 +5,7 @@ use super::{encode_normals, height_from_image, Channel, Depth, EncodeOptions, He
 use super::{Convention, NormalPlane, Options, Progress};
 use crate::error::{Error, Result};
 use crate::report::Timings;
-use image::{DynamicImage, ExtendedColorType, ImageDecoder, ImageEncoder, ImageReader, Limits};
+use image::{DynamicImage, ExtendedColorType, ImageEncoder};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -17,38 +17,16 @@ fn one_line(e: impl std::fmt::Display) -> String {
     e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-/// Opens and decodes an image, refusing it first if its header claims more than `max_pixels`.
+/// Opens and decodes an image (any format [`crate::scene::image`] reads), refusing it first if its
+/// header claims more than `max_pixels`.
 pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
-    let reader = ImageReader::open(path).map_err(|e| Error::input(path, format!("cannot open: {}", one_line(e))))?;
-    let mut reader =
-        reader.with_guessed_format().map_err(|e| Error::input(path, format!("cannot read: {}", one_line(e))))?;
-    if reader.format().is_none() {
-        return Err(Error::input(path, "not a PNG, TIFF or EXR image"));
-    }
-    // The pixel count is checked below from the header; this only bounds the decoder's own
-    // buffers (RGBA f32 is 16 bytes a pixel) so that the check is not undone by a default.
-    let mut limits = Limits::no_limits();
-    limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 24));
-    reader.limits(limits);
-    let what = match reader.format() {
-        Some(image::ImageFormat::Png) => "cannot decode as PNG".to_string(),
-        Some(image::ImageFormat::Tiff) => "cannot decode as TIFF".to_string(),
-        Some(image::ImageFormat::OpenExr) => "cannot decode as EXR".to_string(),
-        other => format!("cannot decode as {other:?}"),
-    };
-    let decoder = reader.into_decoder().map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
-    let (w, h) = decoder.dimensions();
-    check_size(path, w, h, max_pixels)?;
-    DynamicImage::from_decoder(decoder).map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))
+    crate::scene::image::read_file(path, max_pixels)
 }
 
-/// Reads a height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA, palette), TIFF, or EXR.
+/// Reads a height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA, palette), JPEG, WebP, TIFF, or
+/// EXR.
 pub fn load_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<HeightPlane> {
-    let is_png = ImageReader::open(path)
-        .ok()
-        .and_then(|r| r.with_guessed_format().ok())
-        .is_some_and(|r| r.format() == Some(image::ImageFormat::Png));
-    if is_png {
+    if crate::scene::image::file_is_png(path) {
         if let Some(plane) = load_png_height(path, channel, max_pixels)? {
             return Ok(plane);
         }
@@ -125,17 +103,8 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
 }
 
 fn check_size(path: &Path, w: u32, h: u32, max_pixels: u64) -> Result<()> {
-    let pixels = w as u64 * h as u64;
-    if pixels == 0 {
-        return Err(Error::input(path, format!("image is {w}x{h}: no pixels")));
-    }
-    if pixels > max_pixels {
-        return Err(Error::input(
-            path,
-            format!("image is {w}x{h} = {pixels} pixels, more than the limit of {max_pixels} (--max-pixels)"),
-        ));
-    }
-    Ok(())
+    crate::scene::image::check_size_within(w, h, &crate::scene::image::Limits::file(max_pixels))
+        .map_err(|m| Error::input(path, m))
 }
 
 /// Reads an encoded normal map (RGB or RGBA; 8-bit, 16-bit or float) without decoding texels.
@@ -150,7 +119,8 @@ pub fn load_normal_image(path: &Path, max_pixels: u64) -> Result<NormalImage> {
         DynamicImage::ImageRgb32F(b) => (3, NormalData::F32(b.into_raw())),
         DynamicImage::ImageRgba32F(b) => (4, NormalData::F32(b.into_raw())),
         other => {
-            return Err(Error::input(path, format!("a normal map must be RGB or RGBA, this is {:?}", other.color())))
+            let what = if other.color().has_color() { "has an unusual sample layout" } else { "is greyscale" };
+            return Err(Error::input(path, format!("a normal map must be RGB or RGBA; this image {what}")));
         }
     };
     Ok(NormalImage { width, height, channels, data })

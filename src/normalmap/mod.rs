@@ -9,7 +9,7 @@
 //! [`normals_from_height`] is the float route for callers (`bake`) that want the vectors.
 //!
 //! Library entry points:
-//! - [`load_height`]: any PNG/TIFF/EXR to a height plane, refusing oversized headers first.
+//! - [`load_height`]: any PNG/JPEG/WebP/TIFF/EXR to a height plane, refusing oversized headers first.
 //! - [`normals_from_height`] / [`height_to_normal`]: float unit normals.
 //! - [`encode_normals`]: filter + encode in one pass; [`encode_plane`] for float normals.
 //! - [`write_normal_image`], [`png_bytes`]: files; [`decode_normal_image`]: back to vectors.

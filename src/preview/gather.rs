@@ -294,11 +294,15 @@ impl Cx<'_> {
         if !s.has_texture(ti) {
             return Err(s.err(format!("texture {ti} does not exist")));
         }
-        let Some(src) = t.images.first() else {
-            self.notes.push(format!("texture {ti} has no image source; drawn without it"));
+        let choice = s.texture_image_to_decode(ti)?;
+        self.notes.extend(choice.note(ti));
+        let Some((chosen, bytes)) = choice.chosen else {
+            if choice.passed_over.is_empty() {
+                self.notes.push(format!("texture {ti} has no image; drawn without it"));
+            }
             return Ok(None);
         };
-        let img = src.image;
+        let img = chosen.image;
         let sampler = Sampler::from_json(s.sampler_json(t.sampler));
         let texcoord = t.tex_coord;
         if texcoord > 1 {
@@ -308,47 +312,13 @@ impl Cx<'_> {
         let texture = match self.textures.get(&(img, srgb)) {
             Some(t) => t.clone(),
             None => {
-                let bytes = image_bytes(s, img)?;
-                let t = match Texture::decode(&bytes, srgb) {
-                    Ok(t) => Arc::new(t),
-                    // Only an extension's image (no plain `source` to fall back on) may be in a
-                    // format the preview cannot read; say so and draw without it.
-                    Err(e) if src.via != "source" => {
-                        self.notes.push(format!("texture {ti}: image {img} ({}) not drawn: {e}", src.via));
-                        return Ok(None);
-                    }
-                    Err(e) => return Err(s.err(format!("image {img}: {e}"))),
-                };
+                let t = Arc::new(Texture::decode(&bytes, srgb).map_err(|e| s.err(format!("image {img}: {e}")))?);
                 self.textures.insert((img, srgb), t.clone());
                 t
             }
         };
         Ok(Some(TexRef { texture, sampler, texcoord, transform: t.transform }))
     }
-}
-
-/// The encoded bytes of `images[img]`, from a URI (data or file) or a buffer view.
-fn image_bytes(s: &Scene, img: usize) -> Result<Vec<u8>> {
-    let ij = s.json.pointer(&format!("/images/{img}")).ok_or_else(|| s.err(format!("image {img} does not exist")))?;
-    if let Some(uri) = ij.get("uri").and_then(|u| u.as_str()) {
-        return crate::scene::uri::read(uri, &s.base_dir, &s.source, s.allow_outside);
-    }
-    let bv = ij
-        .get("bufferView")
-        .and_then(|b| b.as_u64())
-        .ok_or_else(|| s.err(format!("image {img} has neither uri nor bufferView")))?;
-    let v = s
-        .json
-        .pointer(&format!("/bufferViews/{bv}"))
-        .ok_or_else(|| s.err(format!("image {img}: bufferView {bv} does not exist")))?;
-    let b = v.get("buffer").and_then(|b| b.as_u64()).unwrap_or(0) as usize;
-    let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-    let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-    s.buffers
-        .get(b)
-        .and_then(|buf| buf.get(off..off.checked_add(len)?))
-        .map(|x| x.to_vec())
-        .ok_or_else(|| s.err(format!("image {img}: bufferView {bv} lies outside its buffer")))
 }
 
 /// Every (mesh, world matrix) the scene shows.

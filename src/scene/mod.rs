@@ -12,7 +12,7 @@ pub mod dequant;
 pub mod draco;
 mod gltf_read;
 mod gltf_write;
-pub mod image_limits;
+pub mod image;
 pub mod material;
 mod meshopt;
 mod obj;

@@ -344,7 +344,7 @@ fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<(
 
 /// A bump texture is a normal map when its pixels are coloured and lean towards +Z (blue);
 /// grey pixels are heights. Images that cannot be read or decoded (missing, corrupt, or claiming
-/// more pixels than [`super::image_limits`] allows, checked from the header before anything is
+/// more pixels than [`super::image::Limits::TEXTURE`] allows, checked from the header before anything is
 /// allocated) count as heights, with a note saying why; `bake` reports them when it needs them.
 fn looks_like_normal_map(scene: &mut Scene, file: &str) -> bool {
     let bytes = match super::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) {
@@ -356,7 +356,7 @@ fn looks_like_normal_map(scene: &mut Scene, file: &str) -> bool {
             return false;
         }
     };
-    let img = match super::image_limits::decode(&bytes) {
+    let img = match super::image::decode(&bytes) {
         Ok(i) => i,
         Err(e) => {
             scene.notes.push(format!("bump map '{file}': {e}; taken as a height map"));

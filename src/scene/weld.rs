@@ -174,6 +174,8 @@ pub struct SplitPlan {
     origins: Vec<u32>,
     leave_out: Vec<String>,
     extra: Vec<(usize, String, Stream)>,
+    /// Streams added to morph targets: (target, name, stream).
+    target_extra: Vec<(usize, String, Stream)>,
 }
 
 impl SplitPlan {
@@ -181,12 +183,27 @@ impl SplitPlan {
     /// then only compares its new values (bit for bit) with the vertices already made from its
     /// vertex's class.
     pub fn new(base: &Primitive, leave_out: &[&str], extra: &[CornerStream]) -> SplitPlan {
+        SplitPlan::with_targets(base, leave_out, extra, &[])
+    }
+
+    /// [`SplitPlan::new`] that also adds per-corner streams to morph targets (`(target, stream)`;
+    /// a target's stream is appended to it). `leave_out` applies to the targets' streams too, so
+    /// that a target's old TANGENT gives way to the new one.
+    pub fn with_targets(
+        base: &Primitive,
+        leave_out: &[&str],
+        extra: &[CornerStream],
+        target_extra: &[(usize, CornerStream)],
+    ) -> SplitPlan {
         use rayon::prelude::*;
         let corners = base.indices.len();
         let kept: Vec<&(String, Stream)> =
             base.attributes.iter().filter(|(n, _)| !leave_out.contains(&n.as_str())).collect();
-        let vertex_streams: Vec<&Stream> =
-            kept.iter().map(|(_, s)| s).chain(base.targets.iter().flatten().map(|(_, s)| s)).collect();
+        let kept_targets = base.targets.iter().flatten().filter(|(n, _)| !leave_out.contains(&n.as_str()));
+        let vertex_streams: Vec<&Stream> = kept.iter().map(|(_, s)| s).chain(kept_targets.map(|(_, s)| s)).collect();
+        // Target streams are added values like any other: a vertex splits where they differ.
+        let all_extra: Vec<CornerStream> = extra.iter().chain(target_extra.iter().map(|(_, s)| s)).copied().collect();
+        let extra = all_extra.as_slice();
         let n_vertices = base.vertex_count().max(base.indices.iter().map(|&v| v as usize + 1).max().unwrap_or(0));
         let mut used = vec![false; n_vertices];
         for &v in &base.indices {
@@ -255,14 +272,22 @@ impl SplitPlan {
             indices.push(m);
         }
         drop((made_first, made_more, class));
-        let extra = extra
+        let mut made: Vec<(usize, String, Stream)> = extra
             .iter()
             .zip(data)
             .map(|(s, data)| {
                 (s.at, s.name.to_string(), Stream { format: super::accessor::Format::f32(s.ty), data, template: None })
             })
             .collect();
-        SplitPlan { indices, origins, leave_out: leave_out.iter().map(|s| s.to_string()).collect(), extra }
+        let target_made = made.split_off(made.len() - target_extra.len());
+        let target_extra = target_extra.iter().zip(target_made).map(|((t, _), (_, n, s))| (*t, n, s)).collect();
+        SplitPlan {
+            indices,
+            origins,
+            leave_out: leave_out.iter().map(|s| s.to_string()).collect(),
+            extra: made,
+            target_extra,
+        }
     }
 
     /// Number of vertices the primitive will have.
@@ -285,7 +310,16 @@ impl SplitPlan {
                 attributes.push((name, stream));
             }
         }
-        Primitive { attributes, targets: targets.into_iter().map(gather).collect(), indices: self.indices, mode }
+        let mut targets: Vec<Vec<(String, Stream)>> = targets
+            .into_iter()
+            .map(|t| gather(t.into_iter().filter(|(n, _)| !self.leave_out.contains(n)).collect()))
+            .collect();
+        for (t, name, stream) in self.target_extra {
+            if let Some(target) = targets.get_mut(t) {
+                target.push((name, stream));
+            }
+        }
+        Primitive { attributes, targets, indices: self.indices, mode }
     }
 }
 

@@ -1,6 +1,7 @@
 //! Tangent frames: MikkTSpace generation ([`mikk`]), the fallback for corners the reference
 //! leaves undefined ([`fallback`]), and applying both to a primitive, splitting vertices whose
-//! corners got different frames and merging identical ones ([`primitive_with_tangents`]).
+//! corners got different frames and merging identical ones ([`primitive_with_tangents`]), with
+//! TANGENT deltas for the morph targets that move the surface ([`morph`]).
 //! [`apply`] decides which primitives of a scene need tangents.
 
 pub mod apply;
@@ -9,6 +10,7 @@ pub mod fallback;
 pub mod fast;
 pub mod frames;
 pub mod mikk;
+mod morph;
 
 use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
 use crate::scene::{dequant, flat_normals, Primitive, UvTransform};
@@ -157,7 +159,28 @@ fn split_plan(
             values: CornerValues::Fn(&bitangent),
         });
     }
-    (SplitPlan::new(p, &["TANGENT", "_BITANGENT"], &extra), fallback)
+    let morph = if morph::needed(p, &uv_name) {
+        let base = morph::Base { tangent: &tangent, normals: &normals, generated_normals };
+        morph::deltas(p, &uv_name, &base, uv_v_up, opts.engine)
+    } else {
+        Vec::new()
+    };
+    let target_extra: Vec<(usize, CornerStream)> = morph
+        .iter()
+        .enumerate()
+        .map(|(t, d)| {
+            (
+                t,
+                CornerStream {
+                    at: usize::MAX,
+                    name: "TANGENT",
+                    ty: "VEC3",
+                    values: CornerValues::Flat(d.as_flattened()),
+                },
+            )
+        })
+        .collect();
+    (SplitPlan::with_targets(p, &["TANGENT", "_BITANGENT"], &extra, &target_extra), fallback)
 }
 
 /// Stack bytes the reference needs per triangle around one vertex, with a wide margin.

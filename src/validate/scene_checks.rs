@@ -4,7 +4,7 @@
 use super::frames::{self, Explained, PrimData, Quant};
 use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
 use crate::error::Result;
-use crate::scene::{dequant, Materials, PrimRef, Scene};
+use crate::scene::{dequant, image, Materials, PrimRef, Scene};
 use crate::tangent::apply::to_triangle_list;
 use rayon::prelude::*;
 use serde_json::Value;
@@ -253,24 +253,23 @@ fn local_det_sign(node: &Value) -> i8 {
     }
 }
 
-/// Each image some material uses as its normal texture (or clearcoat normal texture), checked once.
+/// Each image some material's normal (or clearcoat normal) texture can show, its core source and
+/// those of EXT_texture_webp and KHR_texture_basisu (different clients show different ones),
+/// checked once.
 fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
-    let users: BTreeMap<usize, Vec<String>> = mats
-        .normal_images()
-        .into_iter()
-        .map(|(i, users)| {
-            let mut names: Vec<String> = Vec::new();
-            for (m, _) in users {
-                if !names.contains(&m.label()) {
-                    names.push(m.label());
-                }
+    let mut users: BTreeMap<usize, (Vec<String>, Option<&'static str>)> = BTreeMap::new();
+    for (m, t) in mats.normal_images().into_values().flatten() {
+        for ti in scene.texture_images(t.texture) {
+            let entry = users.entry(ti.image).or_default();
+            if !entry.0.contains(&m.label()) {
+                entry.0.push(m.label());
             }
-            (i, names)
-        })
-        .collect();
+            entry.1 = entry.1.or(ti.extension);
+        }
+    }
     users
         .into_iter()
-        .map(|(i, mats)| {
+        .map(|(i, (mats, extension))| {
             let img_json = scene.json.pointer(&format!("/images/{i}")).cloned().unwrap_or(Value::Null);
             let label = img_json
                 .get("name")
@@ -280,10 +279,26 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
                 .unwrap_or(format!("image {i}"));
             let mut s = Subject::new("image", label);
             s.image = Some(i);
-            let wanted_by = format!("{} (as a normal map)", mats.join(", "));
-            match image_bytes(scene, &img_json)
-                .and_then(|b| image::load_from_memory(&b).map_err(|e| format!("cannot decode: {e}")))
-            {
+            let via = extension.map(|e| format!(", through {e}")).unwrap_or_default();
+            let wanted_by = format!("{} (as a normal map{via})", mats.join(", "));
+            let bytes = scene.image_bytes(i).map_err(|e| e.to_string());
+            let kind = bytes.as_deref().map(image::Kind::sniff).unwrap_or(image::Kind::Unknown);
+            if bytes.is_ok() && !kind.is_decoded() && kind != image::Kind::Unknown {
+                let what = match kind {
+                    image::Kind::Ktx2 => "KTX2 (Basis Universal)".to_string(),
+                    k => k.name().to_string(),
+                };
+                let f = Finding::new(
+                    Code::NORMALMAP_NOT_DECODED,
+                    1,
+                    1,
+                    "images",
+                    format!("not checked: {what} images are not decoded by bumpbake (it reads {})", image::DECODED),
+                );
+                s.check(Code::NORMALMAP_NOT_DECODED, Some(f));
+                return s;
+            }
+            match bytes.and_then(|b| image::decode(&b)) {
                 Ok(img) => normal_image::check(&img, Convention::OpenGl, &wanted_by, &mut s),
                 Err(e) => s.check(
                     Code::NORMALMAP_UNREADABLE,
@@ -299,22 +314,4 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
             s
         })
         .collect()
-}
-
-fn image_bytes(scene: &Scene, img: &Value) -> std::result::Result<Vec<u8>, String> {
-    if let Some(uri) = img.get("uri").and_then(|u| u.as_str()) {
-        return crate::scene::uri::read(uri, &scene.base_dir, &scene.source, scene.allow_outside)
-            .map_err(|e| e.to_string());
-    }
-    let view = img.get("bufferView").and_then(|v| v.as_u64()).ok_or("the image has neither uri nor bufferView")?;
-    let v = scene.json.pointer(&format!("/bufferViews/{view}")).ok_or(format!("bufferView {view} does not exist"))?;
-    let b = v.get("buffer").and_then(|b| b.as_u64()).unwrap_or(0) as usize;
-    let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-    let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-    scene
-        .buffers
-        .get(b)
-        .and_then(|buf| buf.get(off..off.checked_add(len)?))
-        .map(|s| s.to_vec())
-        .ok_or(format!("bufferView {view} lies outside its buffer"))
 }
