@@ -168,7 +168,7 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
             use image::ImageDecoder;
             let reader = image::ImageReader::new(std::io::Cursor::new(&bytes)).with_guessed_format();
             match reader.map_err(|e| e.to_string()).and_then(|r| {
-                info.format = r.format().map(|f| format!("{f:?}").to_lowercase());
+                info.format = r.format().and_then(|f| f.extensions_str().first()).map(|e| e.to_string());
                 r.into_decoder().map_err(|e| e.to_string())
             }) {
                 Ok(dec) => {
@@ -176,7 +176,7 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
                     let ct = dec.color_type();
                     info.width = Some(w);
                     info.height = Some(h);
-                    info.color = Some(format!("{ct:?}"));
+                    info.color = Some(crate::normalmap::colour_words(ct));
                     info.bits_per_channel = Some(ct.bits_per_pixel() / ct.channel_count() as u16);
                 }
                 Err(e) => info.error = Some(e),

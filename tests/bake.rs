@@ -310,3 +310,19 @@ fn external_images_and_depfile() {
         assert!(deps.contains(s(&fixture(f))), "{f} in {deps}");
     }
 }
+
+/// `bake` reports what it did with an MTL height map, not advice to run itself; `tangents`, which
+/// leaves the height map alone, is the command that points to `bake`.
+#[test]
+fn height_map_note_only_where_the_map_is_not_converted() {
+    let v = validated_dir("bake_torus_note");
+    let out = v.join("torus.glb");
+    let o = run_ok(&["bake", s(&fixture("bake/torus.obj")), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("height map from"), "bake says it converted the height map: {err}");
+    assert!(!err.contains("bumpbake bake"), "bake does not advise running bake: {err}");
+    let out = v.join("torus_tangents.glb");
+    let o = run_ok(&["tangents", s(&fixture("bake/torus.obj")), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("'bumps.png' is a height map") && err.contains("`bumpbake bake` converts it"), "{err}");
+}

@@ -116,9 +116,9 @@ pub fn run(a: BenchTangentsArgs) -> Result<u8> {
     }
     if a.json {
         let s = serde_json::to_string_pretty(&report).map_err(|e| bumpbake::Error::usage(e.to_string()))?;
-        println!("{s}");
+        outln!("{s}");
     } else {
-        print!("{}", tangents::table(&report));
+        out!("{}", tangents::table(&report));
     }
     Ok(0)
 }

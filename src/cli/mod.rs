@@ -1,5 +1,8 @@
 //! Command-line types (clap derive), one file per subcommand, each with its `run`.
 
+#[macro_use]
+mod out;
+
 mod bake;
 mod bench;
 mod bench_batch;

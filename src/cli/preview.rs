@@ -176,7 +176,7 @@ pub fn run(a: Args) -> Result<u8> {
             let j = serde_json::json!({
                 "reference": reference, "compare": cand, "output": a.output, "time_ms": ms, "comparison": cmp,
             });
-            println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
+            outln!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
         } else if !a.quiet {
             eprintln!(
                 "preview: {} vs {} -> {} ({}x{}, {:.0} ms)",
@@ -224,7 +224,7 @@ pub fn run(a: Args) -> Result<u8> {
             "input": input, "output": a.output, "view": opts.view.name(), "width": opts.width, "height": opts.height,
             "ssaa": opts.ssaa, "triangles": prep.triangle_count(), "notes": prep.notes, "time_ms": ms, "stages": stages,
         });
-        println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
+        outln!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
     } else if !a.quiet {
         eprintln!(
             "preview: {} -> {} ({}x{}, {} view, {} triangles, {:.0} ms)",

@@ -31,11 +31,15 @@ pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
     limits.max_alloc = Some(max_pixels.saturating_mul(16).max(1 << 24));
     reader.limits(limits);
     let what = match reader.format() {
-        Some(image::ImageFormat::Png) => "cannot decode as PNG".to_string(),
-        Some(image::ImageFormat::Tiff) => "cannot decode as TIFF".to_string(),
-        Some(image::ImageFormat::OpenExr) => "cannot decode as EXR".to_string(),
-        other => format!("cannot decode as {other:?}"),
+        Some(image::ImageFormat::Png) => "cannot decode as PNG",
+        Some(image::ImageFormat::Tiff) => "cannot decode as TIFF",
+        Some(image::ImageFormat::OpenExr) => "cannot decode as EXR",
+        Some(other) => return Err(Error::input(path, crate::scene::image_limits::unsupported_format(other))),
+        None => unreachable!("checked above"),
     };
+    if reader.format() == Some(image::ImageFormat::Png) {
+        check_png_complete(path)?;
+    }
     let decoder = reader.into_decoder().map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
     let (w, h) = decoder.dimensions();
     check_size(path, w, h, max_pixels)?;
@@ -66,6 +70,7 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
     let mut decoder = png::Decoder::new(std::io::BufReader::with_capacity(1 << 16, file));
     decoder.set_transformations(png::Transformations::EXPAND);
     decoder.set_limits(png::Limits { bytes: usize::MAX });
+    check_png_complete(path)?;
     let mut reader = decoder.read_info().map_err(bad)?;
     let (w, h) = (reader.info().width, reader.info().height);
     check_size(path, w, h, max_pixels)?;
@@ -112,6 +117,10 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
                     return;
                 }
             }
+            // The rows can all be there while the compressed stream's checksum is not.
+            if let Err(e) = reader.finish() {
+                let _ = tx.send(Err(bad(e)));
+            }
         });
         for (rows, batch) in data.chunks_mut(w * BATCH).zip(rx.iter()) {
             let (row_len, raw) = batch?;
@@ -119,9 +128,35 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
                 convert(r, out);
             }
         }
-        Ok(())
+        match rx.recv() {
+            Ok(Err(e)) => Err(e),
+            _ => Ok(()),
+        }
     })?;
     Ok(Some(HeightPlane { width: w, height: h, data }))
+}
+
+/// Refuses a PNG whose chunks stop before `IEND`: a truncated file (an unfinished copy, most
+/// often) can still yield rows, and must not become a map. Only chunk headers are read.
+fn check_png_complete(path: &Path) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let truncated =
+        || Error::input(path, "the PNG file is truncated (it ends before its IEND chunk); is the copy unfinished?");
+    let mut f = std::fs::File::open(path).map_err(|e| Error::input(path, format!("cannot open: {}", one_line(e))))?;
+    let size = f.metadata().map(|m| m.len()).unwrap_or(u64::MAX);
+    let mut at = 8u64;
+    let mut header = [0u8; 8];
+    loop {
+        if at.checked_add(12).is_none_or(|end| end > size) {
+            return Err(truncated());
+        }
+        f.seek(SeekFrom::Start(at)).and_then(|_| f.read_exact(&mut header)).map_err(|_| truncated())?;
+        let len = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as u64;
+        if &header[4..8] == b"IEND" {
+            return Ok(());
+        }
+        at = at + 12 + len;
+    }
 }
 
 fn check_size(path: &Path, w: u32, h: u32, max_pixels: u64) -> Result<()> {
@@ -150,10 +185,27 @@ pub fn load_normal_image(path: &Path, max_pixels: u64) -> Result<NormalImage> {
         DynamicImage::ImageRgb32F(b) => (3, NormalData::F32(b.into_raw())),
         DynamicImage::ImageRgba32F(b) => (4, NormalData::F32(b.into_raw())),
         other => {
-            return Err(Error::input(path, format!("a normal map must be RGB or RGBA, this is {:?}", other.color())))
+            return Err(Error::input(
+                path,
+                format!("a normal map must be RGB or RGBA, this is {}", colour_words(other.color())),
+            ))
         }
     };
     Ok(NormalImage { width, height, channels, data })
+}
+
+/// A colour type in words: "grey 8-bit", "grey+alpha 16-bit", "RGB float".
+pub fn colour_words(c: image::ColorType) -> String {
+    let kind = match c.channel_count() {
+        1 => "grey",
+        2 => "grey+alpha",
+        3 => "RGB",
+        _ => "RGBA",
+    };
+    if matches!(c, image::ColorType::Rgb32F | image::ColorType::Rgba32F) {
+        return format!("{kind} float");
+    }
+    format!("{kind} {}-bit", c.bits_per_pixel() / c.channel_count() as u16)
 }
 
 /// Reads a normal map and decodes it to vectors (`n = 2·texel - 1`, OpenGL convention,
@@ -295,10 +347,11 @@ pub struct Convert {
 /// PNG output is streamed: strips of rows are filtered (in parallel) into one reused buffer and
 /// handed to the compressor, so the encoded map never exists whole and memory stays at about
 /// the height plane plus the compressed file.
-pub fn convert_file(c: &Convert, progress: Progress) -> Result<Timings> {
+pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<String>)> {
     let format = OutputFormat::from_path(&c.output)?;
     let mut t = Timings::default();
     let height = t.time("decode", || load_height(&c.input, c.channel, c.max_pixels))?;
+    let warning = super::flat_warning(&height, c.options.strength, 1.0);
     let bytes = if format == OutputFormat::Png && c.encode.depth != Depth::Float {
         let (bytes, filter_ms, encode_ms) =
             png_streamed(&height, &c.options, &c.encode, c.png, progress).map_err(|m| Error::output(&c.output, m))?;
@@ -311,7 +364,7 @@ pub fn convert_file(c: &Convert, progress: Progress) -> Result<Timings> {
         t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))?
     };
     t.time("write", || crate::output::write_atomic(&c.output, &bytes))?;
-    Ok(t)
+    Ok((t, warning))
 }
 
 /// Strip-by-strip filtering and PNG compression; returns the bytes and the time spent in

@@ -96,7 +96,8 @@ impl Texture {
     /// Decodes PNG/JPEG/... bytes. Colour textures are sRGB-encoded in glTF and are linearised
     /// here; data textures (normal maps) must keep their encoded values, so `srgb` is false.
     pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
-        let img = image::load_from_memory(bytes).map_err(|e| format!("cannot decode image: {e}"))?;
+        let img = image::load_from_memory(bytes)
+            .map_err(|e| format!("cannot decode image: {}", crate::scene::image_limits::decode_error_words(&e)))?;
         let rgba = img.to_rgba32f();
         let (w, h) = (rgba.width() as usize, rgba.height() as usize);
         if w == 0 || h == 0 {

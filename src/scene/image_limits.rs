@@ -60,12 +60,28 @@ pub fn check_size(w: u32, h: u32) -> Result<(), String> {
     Ok(())
 }
 
+/// Why an image in a format bumpbake does not read is refused, in words.
+pub fn unsupported_format(format: image::ImageFormat) -> String {
+    let name = format.extensions_str().first().map(|e| e.to_uppercase()).unwrap_or_else(|| "this format's".into());
+    format!("{name} images cannot be read (bumpbake reads PNG, TIFF and EXR); convert it to PNG")
+}
+
+/// A decoding error in words: the image crate names unsupported formats by their Rust names.
+pub fn decode_error_words(e: &image::ImageError) -> String {
+    if let image::ImageError::Unsupported(u) = e {
+        if let image::error::ImageFormatHint::Exact(f) = u.format_hint() {
+            return unsupported_format(f);
+        }
+    }
+    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
 /// Decodes an image after checking its header, under [`limits`].
 pub fn decode(bytes: &[u8]) -> Result<DynamicImage, String> {
     dimensions(bytes)?;
     let mut r = reader(bytes)?;
     r.limits(limits());
-    r.decode().map_err(|e| format!("cannot decode image: {e}"))
+    r.decode().map_err(|e| format!("cannot decode image: {}", decode_error_words(&e)))
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@ mod gltf_read;
 mod gltf_write;
 pub mod image_limits;
 mod obj;
+pub mod texcoord;
 pub mod uri;
 pub mod weld;
 

@@ -290,8 +290,15 @@ pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
         let scene = Scene::read(path, &opts.read)?;
         FileReport { path: path.to_path_buf(), kind: "mesh", subjects: validate_scene(&scene, opts)? }
     } else {
-        let img = image::load_from_memory(&bytes)
-            .map_err(|e| Error::input(path, format!("neither a mesh (.gltf, .glb, .obj) nor a readable image: {e}")))?;
+        let img = image::load_from_memory(&bytes).map_err(|e| {
+            Error::input(
+                path,
+                format!(
+                    "neither a mesh (.gltf, .glb, .obj) nor a readable image: {}",
+                    crate::scene::image_limits::decode_error_words(&e)
+                ),
+            )
+        })?;
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let mut subject = Subject::new("image", name);
         validate_normal_image(&img, opts.image_convention, "the command line", &mut subject);

@@ -168,7 +168,7 @@ pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut 
             };
             if !n.iter().all(|v| v.is_finite()) {
                 nonunit += 1;
-                w_nu.push(f64::INFINITY, || texel(format!("decodes to {n:?}")));
+                w_nu.push(f64::INFINITY, || texel(format!("decodes to ({}, {}, {})", n[0], n[1], n[2])));
                 continue;
             }
             // Half an 8-bit step below zero: 127 is negative, 128 (z = 0 rounded) is not.

@@ -18,6 +18,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.mesh = Some(r.mesh);
         s.primitive = Some(r.primitive);
         let pj = scene.prim_json(r);
+        check_texcoords(scene, r, &mut s);
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
         let why = if pj.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
             Some("compressed with KHR_draco_mesh_compression, which bumpbake cannot decode".to_string())
@@ -74,6 +75,30 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     }
     done.extend(check_images(scene));
     Ok(done)
+}
+
+/// Each texture of the primitive's material must find the UV set it reads.
+fn check_texcoords(scene: &Scene, r: PrimRef, s: &mut Subject) {
+    use crate::scene::texcoord;
+    let Some(material) = scene.material_of(r) else { return };
+    let mut textures = 0;
+    texcoord::texture_infos(material, &mut |_, _| textures += 1);
+    if textures == 0 {
+        return;
+    }
+    let attrs = scene.prim_json(r).get("attributes").and_then(|a| a.as_object());
+    let missing = texcoord::missing_sets(material, |k| attrs.is_some_and(|a| a.contains_key(&format!("TEXCOORD_{k}"))));
+    let finding = (!missing.is_empty()).then(|| {
+        let list: Vec<String> = missing.iter().map(|(tex, set)| format!("{tex} reads TEXCOORD_{set}")).collect();
+        Finding::new(
+            Code::TEXCOORD_MISSING,
+            missing.len(),
+            textures,
+            "textures",
+            format!("the primitive lacks the UV sets its material's textures read: {}", list.join(", ")),
+        )
+    });
+    s.check(Code::TEXCOORD_MISSING, finding);
 }
 
 fn prim_name(scene: &Scene, r: PrimRef) -> String {
@@ -262,9 +287,10 @@ fn check_images(scene: &Scene) -> Vec<Subject> {
             let mut s = Subject::new("image", label);
             s.image = Some(i);
             let wanted_by = format!("{} (glTF normalTexture)", mats.join(", "));
-            match image_bytes(scene, &img_json)
-                .and_then(|b| image::load_from_memory(&b).map_err(|e| format!("cannot decode: {e}")))
-            {
+            match image_bytes(scene, &img_json).and_then(|b| {
+                image::load_from_memory(&b)
+                    .map_err(|e| format!("cannot decode: {}", crate::scene::image_limits::decode_error_words(&e)))
+            }) {
                 Ok(img) => normal_image::check(&img, Convention::OpenGl, &wanted_by, &mut s),
                 Err(e) => s.check(
                     Code::NORMALMAP_UNREADABLE,
