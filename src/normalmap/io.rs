@@ -37,10 +37,11 @@ pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
         Some(other) => return Err(Error::input(path, crate::scene::image_limits::unsupported_format(other))),
         None => unreachable!("checked above"),
     };
-    if reader.format() == Some(image::ImageFormat::Png) {
+    let is_png = reader.format() == Some(image::ImageFormat::Png);
+    let decoder = reader.into_decoder().map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
+    if is_png {
         check_png_complete(path)?;
     }
-    let decoder = reader.into_decoder().map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))?;
     let (w, h) = decoder.dimensions();
     check_size(path, w, h, max_pixels)?;
     DynamicImage::from_decoder(decoder).map_err(|e| Error::input(path, format!("{what}: {}", one_line(e))))
@@ -70,8 +71,8 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
     let mut decoder = png::Decoder::new(std::io::BufReader::with_capacity(1 << 16, file));
     decoder.set_transformations(png::Transformations::EXPAND);
     decoder.set_limits(png::Limits { bytes: usize::MAX });
-    check_png_complete(path)?;
     let mut reader = decoder.read_info().map_err(bad)?;
+    check_png_complete(path)?;
     let (w, h) = (reader.info().width, reader.info().height);
     check_size(path, w, h, max_pixels)?;
     if reader.info().interlaced {
@@ -140,8 +141,12 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
 /// often) can still yield rows, and must not become a map. Only chunk headers are read.
 fn check_png_complete(path: &Path) -> Result<()> {
     use std::io::{Read, Seek, SeekFrom};
-    let truncated =
-        || Error::input(path, "the PNG file is truncated (it ends before its IEND chunk); is the copy unfinished?");
+    let truncated = || {
+        Error::input(
+            path,
+            "cannot decode as PNG: the file is truncated (it ends before its IEND chunk); is the copy unfinished?",
+        )
+    };
     let mut f = std::fs::File::open(path).map_err(|e| Error::input(path, format!("cannot open: {}", one_line(e))))?;
     let size = f.metadata().map(|m| m.len()).unwrap_or(u64::MAX);
     let mut at = 8u64;
