@@ -10,7 +10,7 @@
 //! - [`validate`]: tangent-frame, handedness and normal-map checks.
 //! - [`preview`]: a CPU reference renderer of the course notes' shading model.
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
-//! - [`bench`]: error against run time (`bumpbake bench ...`).
+//! - [`bench`](mod@bench): error against run time (`bumpbake bench ...`).
 
 pub mod bake;
 pub mod batch;

@@ -109,8 +109,8 @@ pub fn plan(prims: &[PrimSets], named: &[BTreeSet<u32>]) -> Renumbering {
         }
     }
     let mut groups: BTreeMap<usize, (Vec<usize>, Vec<usize>)> = BTreeMap::new();
-    for p in 0..prims.len() {
-        if !prims[p].materials.is_empty() {
+    for (p, ps) in prims.iter().enumerate() {
+        if !ps.materials.is_empty() {
             groups.entry(root(&mut parent, p)).or_default().0.push(p);
         }
     }
