@@ -8,7 +8,7 @@ use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Render an asset with the course notes' bump-mapping model on the CPU, or measure pipeline error.
+/// Render an asset with the reference bump-mapping model (shaders/) on the CPU, or measure pipeline error.
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
   bumpbake preview fixtures/khronos/NormalTangentMirrorTest.glb -o mirror.png --size 384x384 --ssaa 2

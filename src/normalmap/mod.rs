@@ -1,4 +1,4 @@
-//! Height maps to tangent-space normal maps (issue 3), following `docs/conventions.md`:
+//! Height maps to tangent-space normal maps, following `docs/conventions.md`:
 //! `n = normalize(-S·dh/dx, -S·dh/dy_up, 1)` with `x` right and `y_up` towards the top row,
 //! OpenGL/glTF `+Y` unless DirectX output is asked for, and rounding (never truncation) when
 //! encoding.
