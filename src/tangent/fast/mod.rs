@@ -319,5 +319,6 @@ fn degenerate<W: Welded>(w: &W, order: &Order, ng: usize, out: &mut Builder) {
     }
 }
 
-#[cfg(test)]
+// Every test here compares with the reference engine.
+#[cfg(all(test, feature = "reference"))]
 mod tests;
