@@ -23,7 +23,8 @@ pub struct BenchTangentsArgs {
     /// Triangles of the one-vertex fan (0 skips it).
     #[arg(long, default_value = "20k", value_parser = parse_count)]
     pub fan: usize,
-    /// Engines: fast, bevy (bevy_mikktspace, the reference every other engine is compared with).
+    /// Engines: fast, bevy (bevy_mikktspace, the reference every other engine is compared with;
+    /// built in with `cargo build --features reference`).
     #[arg(long, value_delimiter = ',', default_value = DEFAULT_ENGINES, value_parser = parse_engine)]
     pub engines: Vec<Engine>,
     /// Timed runs per engine and case; the median is reported.
