@@ -8,9 +8,9 @@
 //! - [`tangent`]: MikkTSpace tangent frames, fallback frames, vertex split and merge.
 //! - [`normalmap`]: height maps to tangent-space normal maps.
 //! - [`validate`]: tangent-frame, handedness and normal-map checks.
-//! - [`preview`]: a CPU reference renderer of the course notes' shading model.
+//! - [`preview`]: a CPU renderer of the reference shading model (`shaders/` in GLSL).
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
-//! - [`bench`]: error against run time (`bumpbake bench ...`).
+//! - [`bench`](mod@bench): error against run time (`bumpbake bench ...`).
 
 pub mod bake;
 pub mod batch;

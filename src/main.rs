@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     return_large_blocks_to_the_system();
+    clean_up_on_signals();
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(code) => ExitCode::from(code),
@@ -35,3 +36,33 @@ fn return_large_blocks_to_the_system() {
 
 #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
 fn return_large_blocks_to_the_system() {}
+
+/// SIGINT, SIGTERM and SIGHUP (Ctrl-C, a build system or CI cancelling the run) remove the
+/// temporaries being written, then end the process with 128 + the signal, as a shell reports it.
+/// The signals are blocked in every thread and taken by one that waits for them, so the cleanup
+/// runs as ordinary code rather than in a signal handler. Children get a fresh mask from std.
+#[cfg(unix)]
+fn clean_up_on_signals() {
+    // SAFETY: plain libc calls on a sigset_t owned here, before any other thread exists, so every
+    // thread started later inherits the blocked mask.
+    unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        for sig in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            libc::sigaddset(&mut set, sig);
+        }
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        std::thread::spawn(move || {
+            let mut sig = 0;
+            if libc::sigwait(&set, &mut sig) == 0 {
+                bumpbake::output::abandon_temporaries();
+                std::process::exit(128 + sig);
+            }
+        });
+    }
+}
+
+#[cfg(not(unix))]
+fn clean_up_on_signals() {}

@@ -1,11 +1,75 @@
 //! Writing outputs safely: every file goes to a temporary name in the target directory and is
 //! renamed into place only when complete, so a failed run never leaves a partial file and never
 //! touches its input (even when the output path is the input path).
+//!
+//! Temporaries are named `.NAME.PID.tmp`. A run that is interrupted (SIGINT, SIGTERM) removes its
+//! own through [`abandon_temporaries`], which the binary calls from its signal thread; one that
+//! is killed outright cannot, so writing `NAME` first removes the `.NAME.PID.tmp` of processes
+//! that no longer exist.
 
 use crate::error::{Error, Result};
 use std::borrow::Cow;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// The temporaries this process has created and not yet renamed, and whether it is exiting.
+/// Creating a temporary happens under this lock, so none can appear after the cleanup ran.
+static TEMPS: Mutex<(Vec<PathBuf>, bool)> = Mutex::new((Vec::new(), false));
+
+fn temps() -> std::sync::MutexGuard<'static, (Vec<PathBuf>, bool)> {
+    TEMPS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes every temporary this process is writing and keeps any new one from being created;
+/// the caller then exits. For the binary's signal handling.
+pub fn abandon_temporaries() {
+    let mut t = temps();
+    t.1 = true;
+    for p in t.0.drain(..) {
+        let _ = std::fs::remove_file(p);
+    }
+    // The lock stays held: a writer thread must not create a file between this and the exit.
+    std::mem::forget(t);
+}
+
+fn forget_temp(tmp: &Path) {
+    temps().0.retain(|p| p != tmp);
+}
+
+/// Removes `.NAME.PID.tmp` files beside `path` whose process is gone (killed while writing).
+fn sweep_stale(dir: &Path, name: &str) {
+    let prefix = format!(".{name}.");
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(pid) = file
+            .to_str()
+            .and_then(|f| f.strip_prefix(&prefix))
+            .and_then(|rest| rest.strip_suffix(".tmp"))
+            .and_then(|pid| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !process_exists(pid) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+#[cfg(unix)]
+fn process_exists(pid: u32) -> bool {
+    let Ok(pid) = libc::pid_t::try_from(pid) else { return true };
+    // SAFETY: signal 0 only asks whether the process exists; nothing is sent.
+    let r = unsafe { libc::kill(pid, 0) };
+    r == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+}
+
+/// Without a cheap way to ask, every process is taken to exist: nothing is swept.
+#[cfg(not(unix))]
+fn process_exists(_pid: u32) -> bool {
+    true
+}
 
 /// A set of files that appear together or not at all (a `.gltf` and its `.bin`, say).
 /// Parts may borrow what they write (a scene's buffers), so the bytes need not exist twice.
@@ -57,15 +121,19 @@ impl<'a> Outputs<'a> {
                 Err(e) => {
                     for (tmp, _) in &temps {
                         let _ = std::fs::remove_file(tmp);
+                        forget_temp(tmp);
                     }
                     return Err(e);
                 }
             }
         }
         for (i, (tmp, path)) in temps.iter().enumerate() {
-            if let Err(e) = std::fs::rename(tmp, path) {
+            let renamed = std::fs::rename(tmp, path);
+            forget_temp(tmp);
+            if let Err(e) = renamed {
                 for (t, _) in &temps[i..] {
                     let _ = std::fs::remove_file(t);
+                    forget_temp(t);
                 }
                 return Err(Error::output(path, e));
             }
@@ -77,7 +145,9 @@ impl<'a> Outputs<'a> {
 /// Writes one file atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = write_temp(path, &[bytes])?;
-    std::fs::rename(&tmp, path).map_err(|e| {
+    let renamed = std::fs::rename(&tmp, path);
+    forget_temp(&tmp);
+    renamed.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         Error::output(path, e)
     })
@@ -89,10 +159,21 @@ fn write_temp(path: &Path, parts: &[impl AsRef<[u8]>]) -> Result<PathBuf> {
         _ => PathBuf::from("."),
     };
     let name = path.file_name().ok_or_else(|| Error::output(path, "not a file name"))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+    let name = name.to_string_lossy();
+    sweep_stale(&dir, &name);
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let file = {
+        let mut t = temps();
+        if t.1 {
+            return Err(Error::output(path, "interrupted"));
+        }
+        let f = std::fs::File::create(&tmp).map_err(|e| Error::output(path, e))?;
+        t.0.push(tmp.clone());
+        f
+    };
     let result = (|| {
         // Buffered: a GLB's binary chunk can be thousands of small parts (views and padding).
-        let mut f = std::io::BufWriter::with_capacity(1 << 16, std::fs::File::create(&tmp)?);
+        let mut f = std::io::BufWriter::with_capacity(1 << 16, file);
         for bytes in parts {
             f.write_all(bytes.as_ref())?;
         }
@@ -100,6 +181,7 @@ fn write_temp(path: &Path, parts: &[impl AsRef<[u8]>]) -> Result<PathBuf> {
     })();
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
+        forget_temp(&tmp);
         return Err(Error::output(path, e));
     }
     Ok(tmp)

@@ -388,3 +388,72 @@ fn primitive_without_position_is_skipped() {
     assert_eq!(report["skipped"], 1, "{report}");
     assert!(report["primitives"][0]["reason"].as_str().unwrap().contains("POSITION"));
 }
+
+/// A PNG whose last IDAT stops before the compressed stream's checksum, with no IEND: an
+/// unfinished copy. Every command that reads height or normal maps refuses it, as validate does.
+#[test]
+fn truncated_png_is_refused_everywhere() {
+    let d = case("truncated_png");
+    // Big enough that the rows are all there without the stream's last bytes.
+    let img =
+        image::ImageBuffer::<image::Luma<u16>, _>::from_fn(256, 256, |x, y| image::Luma([(x * 200 + y * 37) as u16]));
+    let full = d.join("full.png");
+    img.save(&full).unwrap();
+    let bytes = std::fs::read(&full).unwrap();
+    // The IEND chunk is the last 12 bytes; before it, the last IDAT's CRC (4) and the end of its
+    // zlib stream, whose last 4 bytes are the Adler-32 checksum.
+    let cut = bytes.len() - 12 - 4 - 4;
+    assert_eq!(&bytes[bytes.len() - 8..bytes.len() - 4], b"IEND");
+    let png = d.join("cut.png");
+    std::fs::write(&png, &bytes[..cut]).unwrap();
+    let out = d.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let mesh = fixture("bake/torus.obj");
+    let runs: [Vec<&str>; 4] = [
+        vec!["normalmap", s(&png), "-o", "N"],
+        vec!["bake", s(&mesh), "--height", s(&png), "-o", "N.glb"],
+        vec!["bake", s(&mesh), "--normal", s(&png), "-o", "N.glb"],
+        vec!["validate", s(&png)],
+    ];
+    for args in runs {
+        let target = out.join("n.png");
+        let target_glb = out.join("n.glb");
+        let args: Vec<&str> = args
+            .iter()
+            .map(|a| match *a {
+                "N" => s(&target),
+                "N.glb" => s(&target_glb),
+                a => a,
+            })
+            .collect();
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.contains("cut.png") && (err.contains("truncated") || err.contains("end of file")),
+            "{args:?}: {err}"
+        );
+        assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0, "{args:?}: nothing written");
+    }
+}
+
+/// Error lines are plain words: no Rust debug text such as `Some(Jpeg)`.
+#[test]
+fn unsupported_image_formats_are_named_in_words() {
+    let d = case("jpeg_height");
+    let jpg = d.join("h.jpg");
+    // A JPEG's start: SOI, then a JFIF APP0 segment; enough for its format to be recognised.
+    let mut bytes = vec![0xFF, 0xD8, 0xFF, 0xE0, 0x00, 0x10];
+    bytes.extend_from_slice(b"JFIF\0\x01\x01\0\0\x01\0\x01\0\0");
+    bytes.extend_from_slice(&[0xFF, 0xD9]);
+    std::fs::write(&jpg, &bytes).unwrap();
+    let out = d.join("n.png");
+    for args in [vec!["normalmap", s(&jpg), "-o", s(&out)], vec!["validate", s(&jpg)]] {
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("JPG images cannot be read") && err.contains("convert it to PNG"), "{args:?}: {err}");
+        assert!(!err.contains("Some(") && !err.contains("Jpeg"), "{args:?}: debug text in {err}");
+    }
+}

@@ -310,3 +310,106 @@ fn external_images_and_depfile() {
         assert!(deps.contains(s(&fixture(f))), "{f} in {deps}");
     }
 }
+
+/// `bake` reports what it did with an MTL height map, not advice to run itself; `tangents`, which
+/// leaves the height map alone, is the command that points to `bake`.
+#[test]
+fn height_map_note_only_where_the_map_is_not_converted() {
+    let v = validated_dir("bake_torus_note");
+    let out = v.join("torus.glb");
+    let o = run_ok(&["bake", s(&fixture("bake/torus.obj")), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("height map from"), "bake says it converted the height map: {err}");
+    assert!(!err.contains("bumpbake bake"), "bake does not advise running bake: {err}");
+    // `tangents` keeps the UV set no texture reads yet: its output is checked apart from bake's.
+    let out = validated_dir("tangents_torus_note").join("torus.glb");
+    let o = run_ok(&["tangents", s(&fixture("bake/torus.obj")), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("'bumps.png' is a height map") && err.contains("`bumpbake bake` converts it"), "{err}");
+}
+
+/// A mesh without UVs cannot carry a map: exit 2 with one line naming the file and the way out,
+/// and no output (it used to write a normal texture reading a TEXCOORD_0 that does not exist).
+#[test]
+fn mesh_without_uvs_and_a_height_map_is_refused() {
+    let d = scratch_dir("bake_no_uvs");
+    let input = d.join("no_uvs.obj");
+    std::fs::write(&input, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let out = d.join("no_uvs.glb");
+    let o = run(&["bake", s(&input), "--height", s(&fixture("bake/bumps.png")), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains(s(&input)) && err.contains("no UV coordinates") && err.contains("vt lines"), "{err}");
+    assert!(!out.exists(), "nothing written");
+}
+
+/// A primitive with two UV sets whose only texture reads set 1: set 0 goes, set 1 becomes set 0
+/// and the texture reads it there (the Khronos validator reported the unused set).
+#[test]
+fn uv_set_read_alone_becomes_set_0() {
+    let d = scratch_dir("bake_uv1_in");
+    let v = validated_dir("bake_uv1");
+    run_ok(&["normalmap", s(&fixture("bake/bumps.png")), "-o", s(&d.join("n.png")), "--strength", "6"]);
+    let mut g = Gltf::new();
+    let (pos, nrm, uv, idx) = grid(4);
+    let other: Vec<[f32; 2]> = uv.iter().map(|t| [t[1] * 0.5, t[0] * 0.5 + 0.25]).collect();
+    let p = g.floats(&pos, Some(34962));
+    let n = g.floats(&nrm, Some(34962));
+    let t0 = g.floats(&other, Some(34962));
+    let t1 = g.floats(&uv, Some(34962));
+    let i = g.indices(&idx);
+    g.json["images"] = json!([{ "uri": "n.png" }]);
+    g.json["textures"] = json!([{ "source": 0 }]);
+    let m = g.material(json!({ "name": "Skin", "normalTexture": { "index": 0, "texCoord": 1 } }));
+    g.mesh(json!({ "attributes": { "POSITION": p, "NORMAL": n, "TEXCOORD_0": t0, "TEXCOORD_1": t1 }, "indices": i, "material": m }));
+    let input = g.write_gltf(&d, "uv1");
+    let out = v.join("uv1.glb");
+    let o = run_ok(&["bake", s(&input), "-o", s(&out), "--json"]);
+    let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let removed: Vec<&str> = rep["removed"].as_array().unwrap().iter().map(|r| r["what"].as_str().unwrap()).collect();
+    assert!(
+        removed.contains(&"mesh 0 primitive 0: TEXCOORD_0 (no texture reads it; TEXCOORD_1 becomes TEXCOORD_0)"),
+        "{removed:#?}"
+    );
+    assert_validates(&out);
+    let scene = load(&out);
+    assert_nothing_unneeded(&scene);
+    let attrs = scene.prim_json(P0)["attributes"].as_object().unwrap();
+    assert!(attrs.contains_key("TEXCOORD_0") && !attrs.contains_key("TEXCOORD_1"), "{attrs:?}");
+    assert_eq!(scene.normal_texcoord(P0), Some(0));
+    let want: Vec<[f32; 2]> = idx.iter().map(|&k| uv[k as usize]).collect();
+    assert_eq!(corner_attr::<2>(&scene, P0, "TEXCOORD_0"), want, "the set the map reads, moved to 0");
+}
+
+/// A 16-bit Gaussian bump (sigma 30 texels, heights 0..0.25) as a PNG.
+fn gentle_bump(path: &Path) {
+    let img = image::ImageBuffer::<image::Luma<u16>, _>::from_fn(200, 200, |x, y| {
+        let r2 = (x as f64 - 100.0).powi(2) + (y as f64 - 100.0).powi(2);
+        image::Luma([(0.25 * (-r2 / (2.0 * 30.0 * 30.0)).exp() * 65535.0).round() as u16])
+    });
+    img.save(path).unwrap();
+}
+
+/// A gentle height map at the default strength comes out flat: bake says so and names a strength
+/// that shows the relief; at that strength the map is not flat.
+#[test]
+fn a_flat_result_is_warned_about_with_a_strength_that_shows_the_relief() {
+    let d = scratch_dir("bake_flat_in");
+    let v = validated_dir("bake_flat");
+    let bump = d.join("bump.png");
+    gentle_bump(&bump);
+    let mesh = d.join("q.obj");
+    std::fs::write(&mesh, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n")
+        .unwrap();
+    let out = v.join("flat.glb");
+    let o = run_ok(&["bake", s(&mesh), "--height", s(&bump), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("warning: bump.png: the normal map is nearly flat"), "{err}");
+    let strength = err.split("--strength ").nth(1).and_then(|r| r.split_whitespace().next()).expect("a strength");
+    assert_eq!(strength, "110", "tan 30° / steepest slope 0.25 e^-1/2 / 30: {err}");
+    let out = v.join("relief.glb");
+    let o = run_ok(&["bake", s(&mesh), "--height", s(&bump), "--strength", strength, "-o", s(&out)]);
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
+    assert_validates(&out);
+}

@@ -78,3 +78,22 @@ fn man_page_is_roff_with_every_subcommand() {
         );
     }
 }
+
+/// A reader that closes the pipe early (`| head -c 10`) ends the output quietly: no panic, no
+/// "Broken pipe" message, and the exit code the run earned (0: every file was read).
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    use std::io::Read;
+    let file = fixture("khronos/NormalTangentTest.glb");
+    let mut args = vec!["inspect".to_string(), "--json".to_string()];
+    args.extend(std::iter::repeat_n(s(&file).to_string(), 300));
+    let mut child =
+        bin().args(&args).stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+    let mut first = [0u8; 10];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+    // The pipe is closed here, with hundreds of records still to come.
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.is_empty(), "nothing on stderr: {err}");
+}

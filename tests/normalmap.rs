@@ -541,3 +541,30 @@ fn tiff_and_png_inputs_and_outputs_agree() {
     assert_eq!(a, b);
     assert_eq!(a, c);
 }
+
+/// A gentle 16-bit Gaussian bump (sigma 30 texels, heights 0..0.25) at the default strength
+/// rounds to the flat texel everywhere: the command warns and names a strength that shows it,
+/// and `--help` explains the default in terms of the image.
+#[test]
+fn a_flat_result_is_warned_about_and_the_default_strength_explained() {
+    let d = Dir::new();
+    let bump = d.path("bump.png");
+    gray16(&bump, 200, 200, |x, y| {
+        let r2 = (x as f64 - 100.0).powi(2) + (y as f64 - 100.0).powi(2);
+        (0.25 * (-r2 / (2.0 * 30.0 * 30.0)).exp() * 65535.0).round() as u16
+    });
+    let flat = d.path("flat.png");
+    let o = run(&["normalmap", p(&bump), "-o", p(&flat)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let near_flat = |t: &image::Rgb<u8>| t.0[0].abs_diff(128) <= 1 && t.0[1].abs_diff(128) <= 1 && t.0[2] == 255;
+    assert!(read_rgb8(&flat).pixels().all(near_flat), "the map is flat to within one step");
+    assert!(err.contains("warning") && err.contains("nearly flat") && err.contains("--strength 110"), "{err}");
+    let shown = d.path("shown.png");
+    let o = run(&["normalmap", p(&bump), "-o", p(&shown), "--strength", "110"]);
+    assert!(o.status.success() && !String::from_utf8_lossy(&o.stderr).contains("warning"));
+    let tilted = read_rgb8(&shown).pixels().filter(|t| !near_flat(t)).count();
+    assert!(tilted > 200 * 200 / 4, "{tilted} texels show the bump");
+    let help = String::from_utf8_lossy(&run(&["normalmap", "--help"]).stdout).to_string();
+    assert!(help.contains("black-to-white height range") && help.contains("tilts the normal by only 0.6°"), "{help}");
+}

@@ -638,3 +638,16 @@ fn big_grid() {
     write_big_grid(&path, 708); // 708 * 708 * 2 = 1,002,528 triangles
     eprintln!("wrote {}", path.display());
 }
+
+/// A normal texture reading a UV set the primitive lacks is an error (the Khronos validator's
+/// MESH_PRIMITIVE_TOO_FEW_TEXCOORDS): nothing can place the map.
+#[test]
+fn texture_reading_a_missing_uv_set_is_an_error() {
+    let mut p = grid_prim();
+    p.uv = None;
+    let (code, r) = broken("texcoord_missing", &p, true, &[]);
+    let f = finding(&r, "TEXCOORD_MISSING");
+    assert_eq!(f["severity"], "error", "{f:#}");
+    assert!(f["message"].as_str().unwrap().contains("normalTexture reads TEXCOORD_0"), "{f:#}");
+    assert_eq!(code, 1);
+}

@@ -18,13 +18,70 @@ pub struct Removal {
 }
 
 pub fn leave_out(scene: &mut Scene, keep_bitangents: bool) -> Result<Vec<Removal>> {
-    let mut removed = attributes(scene, keep_bitangents)?;
-    if !refs::unknown_object_refs(&scene.json) {
+    let unknown = refs::unknown_object_refs(&scene.json);
+    // An unknown extension may read a UV set by its number: then no set is renumbered.
+    let mut removed = if unknown { Vec::new() } else { renumber_uv_sets(scene) };
+    removed.extend(attributes(scene, keep_bitangents)?);
+    if !unknown {
         removed.extend(materials(scene));
         removed.extend(dedupe_images(scene)?);
         removed.extend(textures_images_samplers(scene)?);
     }
     Ok(removed)
+}
+
+/// UV sets no texture reads go even when a later one is read: the read sets are renumbered from
+/// 0, in primitives and in the materials that name them, where every primitive sharing those
+/// materials has every set they name.
+fn renumber_uv_sets(scene: &mut Scene) -> Vec<Removal> {
+    use crate::scene::texcoord;
+    let refs = scene.primitives();
+    let mats = scene.materials();
+    let prims: Vec<texcoord::PrimSets> = refs
+        .iter()
+        .map(|&r| {
+            let pj = scene.prim_json(r);
+            let materials = mats.of_primitive(scene, r);
+            let sets = pj
+                .get("attributes")
+                .and_then(|a| a.as_object())
+                .into_iter()
+                .flat_map(|a| a.keys())
+                .filter_map(|k| k.strip_prefix("TEXCOORD_")?.parse().ok())
+                .collect();
+            texcoord::PrimSets { materials, sets }
+        })
+        .collect();
+    let named: Vec<_> = scene
+        .json
+        .get("materials")
+        .and_then(|m| m.as_array())
+        .into_iter()
+        .flatten()
+        .map(texcoord::material_named_sets)
+        .collect();
+    let plan = texcoord::plan(&prims, &named);
+    for (m, map) in plan.materials.iter().enumerate() {
+        if let Some(map) = map {
+            texcoord::renumber_material(&mut scene.json["materials"][m], map);
+        }
+    }
+    let mut out = Vec::new();
+    for (r, map) in refs.into_iter().zip(&plan.primitives) {
+        let Some(map) = map else { continue };
+        let moved: Vec<String> =
+            map.iter().filter(|(o, n)| o != n).map(|(o, n)| format!("TEXCOORD_{o} becomes TEXCOORD_{n}")).collect();
+        let why = if moved.is_empty() {
+            "no texture reads it".to_string()
+        } else {
+            format!("no texture reads it; {}", moved.join(", "))
+        };
+        for (name, idx) in texcoord::renumber_primitive(prim_mut(scene, r), map) {
+            let bytes = accessor_bytes(scene, idx);
+            out.push(Removal { what: format!("mesh {} primitive {}: {name} ({why})", r.mesh, r.primitive), bytes });
+        }
+    }
+    out
 }
 
 fn accessor_bytes(scene: &Scene, idx: Option<u64>) -> usize {

@@ -43,17 +43,21 @@ pub fn material_wrap(scene: &Scene, material: usize) -> Wrap {
     }
 }
 
-/// A PNG normal map (glTF convention) from a height map file.
-pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings) -> Result<Vec<u8>> {
+/// A PNG normal map (glTF convention) from a height map file, and a warning when it comes out
+/// (nearly) flat.
+pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings) -> Result<(Vec<u8>, Option<String>)> {
     let plane = normalmap::load_height(path, s.channel, s.max_pixels)?;
     let opts = Options { strength: s.strength * multiplier, filter: s.filter, wrap, invert: s.invert };
+    let warning = normalmap::flat_warning(&plane, opts.strength, multiplier)
+        .map(|w| format!("{}: {w}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()));
     let enc = EncodeOptions {
         depth: if s.sixteen_bit { normalmap::Depth::Bits16 } else { normalmap::Depth::Bits8 },
         convention: Convention::Opengl,
         alpha_height: false,
     };
     let img = normalmap::encode_normals(&plane, &opts, &enc, None);
-    normalmap::png_bytes(&img, PngSettings::default()).map_err(|e| Error::output(path, e))
+    let png = normalmap::png_bytes(&img, PngSettings::default()).map_err(|e| Error::output(path, e))?;
+    Ok((png, warning))
 }
 
 /// What bake decided about a given normal map's green channel.

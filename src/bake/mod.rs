@@ -62,6 +62,8 @@ pub struct BakeReport {
     pub removed_bytes: usize,
     pub written: WriteStats,
     pub notes: Vec<String>,
+    /// Maps that came out (nearly) flat, with a strength that would show their relief.
+    pub warnings: Vec<String>,
     pub timings_ms: Timings,
 }
 
@@ -70,7 +72,9 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
     let mut scene = t.time("read", || Scene::read(&job.mesh, &job.read))?;
     let mut deps = scene.dependencies();
     ensure_material(&mut scene);
-    let targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps))?;
+    let mut warnings = Vec::new();
+    let targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps, &mut warnings))?;
+    check_uv_sets(&scene, job)?;
     let prims = t.time("tangents", || {
         apply(
             &mut scene,
@@ -99,8 +103,37 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
         removed,
         written,
         notes: scene.notes.clone(),
+        warnings,
         timings_ms: t,
     })
+}
+
+/// A texture needs UV coordinates to be placed: a primitive without the set its material's
+/// textures read is refused, not written as a file renderers cannot draw.
+fn check_uv_sets(scene: &Scene, job: &BakeJob) -> Result<()> {
+    for r in scene.primitives() {
+        let Some(material) = scene.material_of(r) else { continue };
+        let attrs = scene.prim_json(r).get("attributes").and_then(|a| a.as_object());
+        let has = |k: u32| attrs.is_some_and(|a| a.contains_key(&format!("TEXCOORD_{k}")));
+        if let Some((tex, set)) = crate::scene::texcoord::missing_sets(material, has).into_iter().next() {
+            let name = material.get("name").and_then(|n| n.as_str()).unwrap_or("(unnamed)");
+            let what =
+                if set == 0 { "no UV coordinates".to_string() } else { format!("no UV set {set} (TEXCOORD_{set})") };
+            let fix = if job.mesh.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+                "give the mesh UVs (vt lines in the OBJ) and bake again"
+            } else {
+                "unwrap the mesh (give it UVs) and bake again"
+            };
+            return Err(Error::input(
+                &job.mesh,
+                format!(
+                    "mesh {} primitive {} has {what}, so material '{name}' cannot place its {tex} on it; {fix}",
+                    r.mesh, r.primitive
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A scene without materials gets one, so that a map has somewhere to go.
@@ -123,7 +156,12 @@ fn material_names(scene: &Scene) -> Vec<Option<String>> {
 }
 
 /// Decides which materials get which map, and attaches them.
-fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Result<Vec<MaterialMap>> {
+fn attach_maps(
+    scene: &mut Scene,
+    job: &BakeJob,
+    deps: &mut Vec<PathBuf>,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<MaterialMap>> {
     let names = material_names(scene);
     let chosen: Option<usize> = match &job.material {
         Some(want) => Some(names.iter().position(|n| n.as_deref() == Some(want.as_str())).ok_or_else(|| {
@@ -161,7 +199,9 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
                 if made.is_none() {
                     made = Some(match &job.map {
                         MapSource::Height(_) => {
-                            (maps::from_height(p, 1.0, maps::material_wrap(scene, m), &job.height)?, None)
+                            let (png, warning) = maps::from_height(p, 1.0, maps::material_wrap(scene, m), &job.height)?;
+                            warnings.extend(warning);
+                            (png, None)
                         }
                         _ => {
                             let (b, c) = maps::from_normal(p, job.normal_convention, job.height.max_pixels)?;
@@ -177,7 +217,9 @@ fn attach_maps(scene: &mut Scene, job: &BakeJob, deps: &mut Vec<PathBuf>) -> Res
             }
             MapSource::Scene => {
                 if let Some(h) = scene.height_maps.iter().find(|h| h.material == m).cloned() {
-                    let png = maps::from_height(&h.path, h.multiplier, maps::material_wrap(scene, m), &job.height)?;
+                    let (png, warning) =
+                        maps::from_height(&h.path, h.multiplier, maps::material_wrap(scene, m), &job.height)?;
+                    warnings.extend(warning);
                     maps::attach(scene, m, &png, &label);
                     out.push(MaterialMap {
                         material: m,
@@ -225,6 +267,9 @@ impl BakeReport {
         }
         for n in &self.notes {
             s += &format!("  note: {n}\n");
+        }
+        for w in &self.warnings {
+            s += &format!("  warning: {w}\n");
         }
         let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
         s += &format!("  time: {}\n", times.join(", "));

@@ -314,7 +314,7 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
     let mut stage_runs: Vec<(f64, Vec<(String, f64)>)> = Vec::new();
     let command_ms = median_ms(runs, || {
         let s = Instant::now();
-        let t = nm::convert_file(&convert, None).expect("converts");
+        let (t, _) = nm::convert_file(&convert, None).expect("converts");
         stage_runs.push((s.elapsed().as_secs_f64(), t.stages));
     });
     stage_runs.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -25,7 +25,12 @@ pub struct Args {
     /// The material that gets the map (default: those with a bump map, or the only one).
     #[arg(long)]
     pub material: Option<String>,
-    /// Height-to-normal strength S (texels of height per unit of h).
+    /// Strength S: how tall the whole black-to-white height range stands, in texels.
+    ///
+    /// At 1, a slope from black to white across 100 texels tilts the normal by only 0.6°: right
+    /// for maps that use their whole range in a few texels (rivets, cracks), too little for gentle
+    /// relief. When the result comes out nearly flat, bake warns and names a strength that shows
+    /// it. An MTL bump map's -bm multiplies it.
     #[arg(long, default_value_t = 1.0, conflicts_with = "height_range")]
     pub strength: f32,
     /// Physical units: height of h = 1, in metres (with --texel-size).

@@ -48,10 +48,11 @@ pub(super) fn with_scratch<T>(what: &str, f: impl FnOnce(&Path, &Path) -> Result
 }
 
 /// Prints `r` as JSON, or as `text(r)`.
-pub(super) fn print<T: serde::Serialize>(r: &T, json: bool, text: impl FnOnce(&T) -> String) {
+pub(super) fn print<T: serde::Serialize>(r: &T, json: bool, text: impl FnOnce(&T) -> String) -> Result<()> {
     if json {
-        println!("{}", serde_json::to_string_pretty(r).expect("serialises"));
+        outln!("{}", serde_json::to_string_pretty(r).expect("serialises"));
     } else {
-        println!("{}", text(r));
+        outln!("{}", text(r));
     }
+    Ok(())
 }

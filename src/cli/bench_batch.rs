@@ -30,6 +30,6 @@ pub fn run(a: BenchBatchArgs) -> Result<u8> {
             "{} assets: one process each {:.0} ms, one batch with -j {} {:.0} ms (medians of {}): ratio {:.2} (target <= 0.6)",
             r.assets, r.one_by_one_ms, r.jobs, r.batch_ms, r.runs, r.ratio
         )
-    });
+    })?;
     Ok(0)
 }

@@ -34,6 +34,6 @@ pub fn run(a: BenchCommandArgs) -> Result<u8> {
             r.peak_kib as f64 * 1024.0 / 1e6,
             r.peak_over_input
         )
-    });
+    })?;
     Ok(0)
 }

@@ -44,9 +44,9 @@ pub fn run(a: BenchNormalmapArgs) -> Result<u8> {
         bumpbake::output::write_atomic(path, svg.as_bytes())?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report).expect("report serialises"));
+        outln!("{}", serde_json::to_string_pretty(&report).expect("report serialises"));
     } else {
-        print!("{}", bn::render_text(&report));
+        out!("{}", bn::render_text(&report));
     }
     Ok(0)
 }

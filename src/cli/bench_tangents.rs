@@ -23,8 +23,9 @@ pub struct BenchTangentsArgs {
     /// Triangles of the one-vertex fan (0 skips it).
     #[arg(long, default_value = "20k", value_parser = parse_count)]
     pub fan: usize,
-    /// Engines: fast, bevy (bevy_mikktspace, the reference every other engine is compared with).
-    #[arg(long, value_delimiter = ',', default_value = "fast,bevy", value_parser = parse_engine)]
+    /// Engines: fast, bevy (bevy_mikktspace, the reference every other engine is compared with;
+    /// built in with `cargo build --features reference`).
+    #[arg(long, value_delimiter = ',', default_value = DEFAULT_ENGINES, value_parser = parse_engine)]
     pub engines: Vec<Engine>,
     /// Timed runs per engine and case; the median is reported.
     #[arg(long, default_value_t = 5)]
@@ -71,9 +72,16 @@ fn parse_surface(s: &str) -> std::result::Result<Surface, String> {
     Surface::parse(s.trim()).ok_or_else(|| format!("unknown surface {s} (sphere, torus, wavy-grid)"))
 }
 
+/// The reference takes part whenever it is built in.
+const DEFAULT_ENGINES: &str = if bumpbake::tangent::mikk::REFERENCE_BUILT_IN { "fast,bevy" } else { "fast" };
+
 fn parse_engine(s: &str) -> std::result::Result<Engine, String> {
     match s.trim() {
         "fast" => Ok(Engine::Fast),
+        "bevy" | "bevy_mikktspace" | "reference" if !bumpbake::tangent::mikk::REFERENCE_BUILT_IN => {
+            Err("the reference engine (bevy_mikktspace) is not built in: build bumpbake with `--features reference`"
+                .into())
+        }
         "bevy" | "bevy_mikktspace" | "reference" => Ok(Engine::Bevy),
         _ => Err(format!("unknown engine {s} (fast, bevy)")),
     }
@@ -116,9 +124,9 @@ pub fn run(a: BenchTangentsArgs) -> Result<u8> {
     }
     if a.json {
         let s = serde_json::to_string_pretty(&report).map_err(|e| bumpbake::Error::usage(e.to_string()))?;
-        println!("{s}");
+        outln!("{s}");
     } else {
-        print!("{}", tangents::table(&report));
+        out!("{}", tangents::table(&report));
     }
     Ok(0)
 }

@@ -20,7 +20,9 @@ pub struct ManArgs {}
 
 pub fn completions(a: CompletionArgs) -> Result<u8> {
     let mut cmd = super::Cli::command();
-    clap_complete::generate(a.shell, &mut cmd, "bumpbake", &mut std::io::stdout());
+    let mut script = Vec::new();
+    clap_complete::generate(a.shell, &mut cmd, "bumpbake", &mut script);
+    super::out::write_all(&script)?;
     Ok(0)
 }
 
@@ -41,7 +43,6 @@ pub fn man(_a: ManArgs) -> Result<u8> {
         Ok(())
     };
     render(&mut out).map_err(|e| Error::output("stdout", e))?;
-    use std::io::Write;
-    std::io::stdout().write_all(&out).map_err(|e| Error::output("stdout", e))?;
+    super::out::write_all(&out)?;
     Ok(0)
 }

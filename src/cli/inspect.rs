@@ -27,9 +27,9 @@ pub fn run(a: Args) -> Result<u8> {
         if a.json {
             let mut v = serde_json::to_value(&i).expect("serialises");
             v["schema"] = serde_json::json!("bumpbake-inspect/1");
-            println!("{v}");
+            outln!("{v}");
         } else {
-            print!("{}", i.text());
+            out!("{}", i.text());
         }
     }
     Ok(0)

@@ -1,5 +1,8 @@
 //! Command-line types (clap derive), one file per subcommand, each with its `run`.
 
+#[macro_use]
+mod out;
+
 mod bake;
 mod bench;
 mod bench_batch;
@@ -42,7 +45,7 @@ pub enum Command {
     Completions(completions::CompletionArgs),
     /// Print the man page.
     Man(completions::ManArgs),
-    /// Render an asset with the course notes' bump-mapping model (CPU), or compare two.
+    /// Render an asset with the reference bump-mapping model (CPU), or compare two.
     Preview(preview::Args),
 }
 

@@ -5,7 +5,6 @@ use bumpbake::batch;
 use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap};
 use bumpbake::{Error, Result};
 use clap::builder::TypedValueParser;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// What alpha holds.
@@ -33,7 +32,12 @@ pub struct Args {
     /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
     #[arg(long, value_enum, default_value_t = Channel::Luma)]
     pub channel: Channel,
-    /// S: texels of surface height per unit of height sample (0..1).
+    /// Strength S: how tall the whole black-to-white height range stands, in texels [default: 1].
+    ///
+    /// At 1, a slope from black to white across 100 texels tilts the normal by only 0.6°: right
+    /// for maps that use their whole range in a few texels (rivets, cracks), too little for gentle
+    /// relief. When the result comes out nearly flat, bumpbake warns and names a strength that
+    /// shows it. With real sizes, give --height-range and --texel-size instead.
     #[arg(long, allow_negative_numbers = true, conflicts_with_all = ["height_range", "texel_size"])]
     pub strength: Option<f32>,
     /// Height of the full 0..1 sample range, in metres (with --texel-size: S = range / texel).
@@ -95,6 +99,8 @@ struct Record {
     input: PathBuf,
     output: PathBuf,
     timings_ms: bumpbake::report::Timings,
+    /// Said on stderr too: a map that came out (nearly) flat.
+    warnings: Vec<String>,
 }
 
 pub fn run(args: Args) -> Result<u8> {
@@ -133,21 +139,31 @@ pub fn run(args: Args) -> Result<u8> {
     let records: Vec<Result<Record>> = results
         .into_iter()
         .zip(args.heights.iter().zip(&outputs))
-        .map(|(r, (i, o))| r.map(|t| Record { input: i.clone(), output: o.clone(), timings_ms: t }))
+        .map(|(r, (i, o))| {
+            r.map(|(t, w)| Record {
+                input: i.clone(),
+                output: o.clone(),
+                timings_ms: t,
+                warnings: w.into_iter().collect(),
+            })
+        })
         .collect();
     super::report::print("bumpbake-normalmap/1", &args.heights, records, args.batch.json, args.batch.quiet, |r| {
-        if args.heights.len() > 1 {
+        let mut s = if args.heights.len() > 1 {
             format!("{} -> {}\n", r.input.display(), r.output.display())
         } else {
             String::new()
+        };
+        for w in &r.warnings {
+            s += &format!("bumpbake: warning: {}: {w}\n", r.input.display());
         }
+        s
     })
 }
 
 /// A bar on a terminal for maps big enough to wait for; nothing when piped or under CI.
 fn progress_bar(args: &Args) -> indicatif::ProgressBar {
-    let ci = std::env::var("CI").map(|v| v == "true" || v == "1").unwrap_or(false);
-    if args.batch.quiet || (!args.batch.progress && (ci || !std::io::stderr().is_terminal())) {
+    if !batch::progress_wanted(args.batch.progress, args.batch.quiet) {
         return indicatif::ProgressBar::hidden();
     }
     // The header is read again by the conversion; this costs microseconds and keeps the

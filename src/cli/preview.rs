@@ -8,7 +8,7 @@ use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Render an asset with the course notes' bump-mapping model on the CPU, or measure pipeline error.
+/// Render an asset with the reference bump-mapping model (shaders/) on the CPU, or measure pipeline error.
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
   bumpbake preview fixtures/khronos/NormalTangentMirrorTest.glb -o mirror.png --size 384x384 --ssaa 2
@@ -176,7 +176,7 @@ pub fn run(a: Args) -> Result<u8> {
             let j = serde_json::json!({
                 "reference": reference, "compare": cand, "output": a.output, "time_ms": ms, "comparison": cmp,
             });
-            println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
+            outln!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
         } else if !a.quiet {
             eprintln!(
                 "preview: {} vs {} -> {} ({}x{}, {:.0} ms)",
@@ -224,7 +224,7 @@ pub fn run(a: Args) -> Result<u8> {
             "input": input, "output": a.output, "view": opts.view.name(), "width": opts.width, "height": opts.height,
             "ssaa": opts.ssaa, "triangles": prep.triangle_count(), "notes": prep.notes, "time_ms": ms, "stages": stages,
         });
-        println!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
+        outln!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
     } else if !a.quiet {
         eprintln!(
             "preview: {} -> {} ({}x{}, {} view, {} triangles, {:.0} ms)",

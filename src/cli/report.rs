@@ -99,7 +99,7 @@ pub fn print<R: serde::Serialize>(
                 let mut v = serde_json::to_value(&rep).expect("report serialises");
                 v["schema"] = serde_json::json!(schema);
                 v["status"] = serde_json::json!("ok");
-                println!("{v}");
+                outln!("{v}");
             }
             Ok(rep) => {
                 if !quiet {
@@ -109,7 +109,7 @@ pub fn print<R: serde::Serialize>(
             Err(e) if single => return Err(e),
             Err(e) => {
                 if json {
-                    println!(
+                    outln!(
                         "{}",
                         serde_json::json!({ "schema": schema, "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() })
                     );

@@ -64,7 +64,7 @@ fn codes(list: &[String]) -> Result<Vec<Code>> {
 pub fn run(a: Args) -> Result<u8> {
     if a.list_codes {
         for c in Code::ALL {
-            println!("{:<26} {:<8} {}", c.as_str(), c.severity().as_str(), c.hint());
+            outln!("{:<26} {:<8} {}", c.as_str(), c.severity().as_str(), c.hint());
         }
         return Ok(0);
     }
@@ -92,12 +92,12 @@ pub fn run(a: Args) -> Result<u8> {
     };
     match a.format {
         Format::Text => {}
-        Format::Json => println!("{}", report::json(&rep)),
-        Format::Junit => print!("{}", report::junit(&rep)),
-        Format::Github => print!("{}", report::github(&rep)),
+        Format::Json => outln!("{}", report::json(&rep)),
+        Format::Junit => out!("{}", report::junit(&rep)),
+        Format::Github => out!("{}", report::github(&rep)),
         Format::Sarif => {
             let unusable: Vec<String> = failed.iter().map(|e| e.to_string()).collect();
-            println!("{}", report::sarif(&rep, &unusable))
+            outln!("{}", report::sarif(&rep, &unusable))
         }
     }
     if !a.quiet {

@@ -45,6 +45,7 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
     decoder.set_transformations(png::Transformations::EXPAND);
     decoder.set_limits(png::Limits { bytes: usize::MAX });
     let mut reader = decoder.read_info().map_err(bad)?;
+    check_png_complete(path)?;
     let (w, h) = (reader.info().width, reader.info().height);
     check_size(path, w, h, max_pixels)?;
     if reader.info().interlaced {
@@ -90,6 +91,10 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
                     return;
                 }
             }
+            // The rows can all be there while the compressed stream's checksum is not.
+            if let Err(e) = reader.finish() {
+                let _ = tx.send(Err(bad(e)));
+            }
         });
         for (rows, batch) in data.chunks_mut(w * BATCH).zip(rx.iter()) {
             let (row_len, raw) = batch?;
@@ -97,9 +102,39 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
                 convert(r, out);
             }
         }
-        Ok(())
+        match rx.recv() {
+            Ok(Err(e)) => Err(e),
+            _ => Ok(()),
+        }
     })?;
     Ok(Some(HeightPlane { width: w, height: h, data }))
+}
+
+/// Refuses a PNG whose chunks stop before `IEND`: a truncated file (an unfinished copy, most
+/// often) can still yield rows, and must not become a map. Only chunk headers are read.
+fn check_png_complete(path: &Path) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let truncated = || {
+        Error::input(
+            path,
+            "cannot decode as PNG: the file is truncated (it ends before its IEND chunk); is the copy unfinished?",
+        )
+    };
+    let mut f = std::fs::File::open(path).map_err(|e| Error::input(path, format!("cannot open: {}", one_line(e))))?;
+    let size = f.metadata().map(|m| m.len()).unwrap_or(u64::MAX);
+    let mut at = 8u64;
+    let mut header = [0u8; 8];
+    loop {
+        if at.checked_add(12).is_none_or(|end| end > size) {
+            return Err(truncated());
+        }
+        f.seek(SeekFrom::Start(at)).and_then(|_| f.read_exact(&mut header)).map_err(|_| truncated())?;
+        let len = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as u64;
+        if &header[4..8] == b"IEND" {
+            return Ok(());
+        }
+        at = at + 12 + len;
+    }
 }
 
 fn check_size(path: &Path, w: u32, h: u32, max_pixels: u64) -> Result<()> {
@@ -119,11 +154,27 @@ pub fn load_normal_image(path: &Path, max_pixels: u64) -> Result<NormalImage> {
         DynamicImage::ImageRgb32F(b) => (3, NormalData::F32(b.into_raw())),
         DynamicImage::ImageRgba32F(b) => (4, NormalData::F32(b.into_raw())),
         other => {
-            let what = if other.color().has_color() { "has an unusual sample layout" } else { "is greyscale" };
-            return Err(Error::input(path, format!("a normal map must be RGB or RGBA; this image {what}")));
+            return Err(Error::input(
+                path,
+                format!("a normal map must be RGB or RGBA, this is {}", colour_words(other.color())),
+            ))
         }
     };
     Ok(NormalImage { width, height, channels, data })
+}
+
+/// A colour type in words: "grey 8-bit", "grey+alpha 16-bit", "RGB float".
+pub fn colour_words(c: image::ColorType) -> String {
+    let kind = match c.channel_count() {
+        1 => "grey",
+        2 => "grey+alpha",
+        3 => "RGB",
+        _ => "RGBA",
+    };
+    if matches!(c, image::ColorType::Rgb32F | image::ColorType::Rgba32F) {
+        return format!("{kind} float");
+    }
+    format!("{kind} {}-bit", c.bits_per_pixel() / c.channel_count() as u16)
 }
 
 /// Reads a normal map and decodes it to vectors (`n = 2·texel - 1`, OpenGL convention,
@@ -265,10 +316,11 @@ pub struct Convert {
 /// PNG output is streamed: strips of rows are filtered (in parallel) into one reused buffer and
 /// handed to the compressor, so the encoded map never exists whole and memory stays at about
 /// the height plane plus the compressed file.
-pub fn convert_file(c: &Convert, progress: Progress) -> Result<Timings> {
+pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<String>)> {
     let format = OutputFormat::from_path(&c.output)?;
     let mut t = Timings::default();
     let height = t.time("decode", || load_height(&c.input, c.channel, c.max_pixels))?;
+    let warning = super::flat_warning(&height, c.options.strength, 1.0);
     let bytes = if format == OutputFormat::Png && c.encode.depth != Depth::Float {
         let (bytes, filter_ms, encode_ms) =
             png_streamed(&height, &c.options, &c.encode, c.png, progress).map_err(|m| Error::output(&c.output, m))?;
@@ -281,7 +333,7 @@ pub fn convert_file(c: &Convert, progress: Progress) -> Result<Timings> {
         t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))?
     };
     t.time("write", || crate::output::write_atomic(&c.output, &bytes))?;
-    Ok(t)
+    Ok((t, warning))
 }
 
 /// Strip-by-strip filtering and PNG compression; returns the bytes and the time spent in

@@ -1,4 +1,4 @@
-//! Height maps to tangent-space normal maps (issue 3), following `docs/conventions.md`:
+//! Height maps to tangent-space normal maps, following `docs/conventions.md`:
 //! `n = normalize(-S·dh/dx, -S·dh/dy_up, 1)` with `x` right and `y_up` towards the top row,
 //! OpenGL/glTF `+Y` unless DirectX output is asked for, and rounding (never truncation) when
 //! encoding.
@@ -14,11 +14,13 @@
 //! - [`encode_normals`]: filter + encode in one pass; [`encode_plane`] for float normals.
 //! - [`write_normal_image`], [`png_bytes`]: files; [`decode_normal_image`]: back to vectors.
 //! - [`convert_file`]: the whole `bumpbake normalmap` command.
+//! - [`flat_warning`]: whether a strength leaves a height map's normal map (nearly) flat.
 
 mod encode;
 mod filter;
 mod height;
 mod io;
+mod relief;
 mod rows;
 mod spectral;
 
@@ -29,9 +31,10 @@ pub use encode::{
 pub use filter::wrap_index;
 pub use height::{height_from_image, Channel, HeightPlane};
 pub use io::{
-    convert_file, decode_normal_image, load_height, load_normal_image, open_image, png_bytes, write_normal_image,
-    Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
+    colour_words, convert_file, decode_normal_image, load_height, load_normal_image, open_image, png_bytes,
+    write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
+pub use relief::{flat_warning, steepest_slope};
 pub use rows::{unit_normal, Progress};
 
 use serde::Serialize;

@@ -1,4 +1,4 @@
-//! A CPU reference renderer of the course notes' bump-mapping model, so that "ready for any
+//! A CPU renderer of the reference bump-mapping model (`shaders/` in GLSL), so that "ready for any
 //! bump-mapping renderer" can be shown, and measured, without a GPU.
 //!
 //! Use: [`Prepared::new`] once per scene (normals, tangents, textures settled), a [`Camera`]

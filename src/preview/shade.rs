@@ -1,4 +1,4 @@
-//! The shading model of the course notes (`shared/seeds/`), step for step.
+//! The shading model of the reference shaders (`shaders/bump.vert`, `shaders/bump.frag`), step for step.
 //!
 //! Vertex stage (per triangle corner): `N` and `T` are moved to world space and normalised,
 //! `B = cross(N, T) * w`; the direction to the eye, the direction to every light and every spot

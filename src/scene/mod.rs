@@ -17,6 +17,7 @@ pub mod material;
 mod meshopt;
 mod obj;
 pub mod refs;
+pub mod texcoord;
 pub mod uri;
 pub mod weld;
 

@@ -327,10 +327,6 @@ fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<(
                 mat["normalTexture"]["scale"] = json!(tex.bm);
             }
         } else {
-            scene.notes.push(format!(
-                "material '{}': bump map '{}' is a height map; `bumpbake bake` converts it",
-                m.name, tex.file
-            ));
             scene.height_maps.push(HeightMapRef {
                 material: index,
                 path: scene.base_dir.join(&tex.file),

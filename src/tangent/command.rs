@@ -48,7 +48,17 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     }
     t.time("write", || files.commit())?;
     crate::report::mem_mark("write");
-    Ok(summarise(&job.input, &job.output, prims, scene.notes, written, t))
+    let mut notes = scene.notes;
+    // `bake` converts these; `tangents` leaves them, and says so.
+    for h in &scene.height_maps {
+        let name = scene.json.pointer(&format!("/materials/{}/name", h.material)).and_then(|n| n.as_str());
+        notes.push(format!(
+            "material '{}': bump map '{}' is a height map, left out; `bumpbake bake` converts it to a normal map",
+            name.unwrap_or("(unnamed)"),
+            h.path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()
+        ));
+    }
+    Ok(summarise(&job.input, &job.output, prims, notes, written, t))
 }
 
 fn summarise(

@@ -8,12 +8,16 @@ use super::TriMesh;
 /// Which implementation computes the reference frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Engine {
-    /// `bevy_mikktspace`: a safe, byte-identical port of the C reference.
+    /// `bevy_mikktspace`: a safe, byte-identical port of the C reference. Only with the
+    /// `reference` feature ([`REFERENCE_BUILT_IN`]).
     Bevy,
     /// [`super::fast`]: the same frames bit for bit, in linear time and on all cores.
     #[default]
     Fast,
 }
+
+/// Whether [`Engine::Bevy`] is built in (the `reference` feature).
+pub const REFERENCE_BUILT_IN: bool = cfg!(feature = "reference");
 
 /// Per-corner MikkTSpace frames `(t.x, t.y, t.z, sign)` in the reference's own sign convention
 /// (`sign = +1` when the UV orientation is preserved), or `None` where the reference gives no
@@ -30,26 +34,38 @@ pub fn frames(mesh: &TriMesh, engine: Engine) -> Vec<[f32; 4]> {
 /// [`generate`] as [`Frames`]: each value once per group of corners the engine shares it among
 /// (the fast engine), or once per corner (the reference), found through `mesh.indices`.
 pub fn compact(mesh: &TriMesh, engine: Engine) -> Frames {
-    let bevy = |mesh: &TriMesh| {
-        Frames::from_flat(mesh.indices, generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect())
-    };
     match engine {
-        Engine::Bevy => bevy(mesh),
+        Engine::Bevy => reference(mesh),
         Engine::Fast => match super::fast::generate(mesh) {
             Ok(out) => out,
-            // Beyond 32-bit corner ids: the reference has no such limit.
-            Err(super::fast::Unsupported::TooLarge) => bevy(mesh),
             // An index past an attribute array: no frame is defined (the reference panics).
-            Err(super::fast::Unsupported::IndexOutOfRange) => Frames::none(mesh.indices),
+            // Beyond 32-bit corner ids (1.4 billion triangles, more than memory holds): no
+            // frames, so every corner gets a substitute, counted in the report.
+            Err(super::fast::Unsupported::IndexOutOfRange | super::fast::Unsupported::TooLarge) => {
+                Frames::none(mesh.indices)
+            }
         },
     }
 }
 
+#[cfg(feature = "reference")]
+fn reference(mesh: &TriMesh) -> Frames {
+    Frames::from_flat(mesh.indices, generate_bevy(mesh).into_iter().map(|t| t.unwrap_or([0.0; 4])).collect())
+}
+
+/// Callers check [`REFERENCE_BUILT_IN`] first (the command line refuses the engine without it).
+#[cfg(not(feature = "reference"))]
+fn reference(_mesh: &TriMesh) -> Frames {
+    panic!("the reference engine (bevy_mikktspace) is not built in: build bumpbake with `--features reference`")
+}
+
+#[cfg(feature = "reference")]
 struct BevyGeometry<'a> {
     mesh: &'a TriMesh<'a>,
     out: Vec<Option<[f32; 4]>>,
 }
 
+#[cfg(feature = "reference")]
 impl bevy_mikktspace::Geometry for BevyGeometry<'_> {
     fn num_faces(&self) -> usize {
         self.mesh.indices.len() / 3
@@ -71,6 +87,7 @@ impl bevy_mikktspace::Geometry for BevyGeometry<'_> {
     }
 }
 
+#[cfg(feature = "reference")]
 fn generate_bevy(mesh: &TriMesh) -> Vec<Option<[f32; 4]>> {
     let mut g = BevyGeometry { mesh, out: vec![None; mesh.indices.len()] };
     // The error type has no variants: generation cannot fail, it can only leave corners unset.

@@ -50,6 +50,8 @@ macro_rules! codes {
 codes! {
     /// A normal texture needs a tangent space and the primitive has no TANGENT.
     TANGENT_MISSING = Warning, "run `bumpbake tangents IN -o OUT`: renderers that derive tangents themselves (many use screen-space derivatives) do not reproduce the frames the map was baked against";
+    /// A material texture reads a UV set (`texCoord`) the primitive does not have.
+    TEXCOORD_MISSING = Error, "give the primitive the UV set the texture reads, or point the texture's texCoord at a set it has (the Khronos validator calls this MESH_PRIMITIVE_TOO_FEW_TEXCOORDS)";
     /// TANGENT is present but nothing reads it (no normal, clearcoat normal or anisotropy texture).
     TANGENT_UNUSED = Info, "nothing uses these tangents: leave them out to save memory";
     /// TANGENT without NORMAL: the glTF spec says to ignore the tangents.
@@ -68,6 +70,8 @@ codes! {
     TANGENT_SEAM_SHARED = Error, "split the seam vertices so each side gets its own w (`bumpbake tangents --overwrite` does)";
     /// Stored tangents are further from MikkTSpace's than `--max-angle-deg`.
     TANGENT_MIKK_ANGLE = Error, "the normal map was baked against MikkTSpace frames the renderer will recompute differently: regenerate tangents with MikkTSpace (`bumpbake tangents --overwrite`) or re-bake the map against these";
+    /// The comparison with MikkTSpace could not run on a primitive that needs it.
+    TANGENT_MIKK_UNCHECKED = Error, "this is a bumpbake bug: please report it with the file; the other checks ran";
     /// Stored w differs from MikkTSpace's sign on a corner no other check explains.
     TANGENT_MIKK_SIGN = Error, "regenerate tangents with MikkTSpace (`bumpbake tangents --overwrite`)";
     TRIANGLE_DEGENERATE = Info, "zero-area triangles have no tangent frame; remove them (weld or decimate) unless they are intentional";

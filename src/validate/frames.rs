@@ -145,6 +145,12 @@ fn fmt_t(t: [f32; 4]) -> String {
     format!("({:.4}, {:.4}, {:.4}, w {})", t[0], t[1], t[2], t[3])
 }
 
+/// A vector as `(x, y, z)`, however many components.
+fn fmt_v(v: &[f32]) -> String {
+    let parts: Vec<String> = v.iter().map(|x| format!("{x:.4}")).collect();
+    format!("({})", parts.join(", "))
+}
+
 /// Finite, unit, `w = ±1`, not parallel to and orthogonal to the normal: per vertex.
 pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
     let Some(t) = &d.tangents else { return };
@@ -161,7 +167,7 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
         if !tv.iter().all(|x| x.is_finite()) {
             nonfinite += 1;
             ex.bad_vertex[v] = true;
-            w_nf.push(1.0, || ex_v(format!("tangent {:?}", tv)));
+            w_nf.push(1.0, || ex_v(format!("tangent {}", fmt_t(tv))));
             continue;
         }
         let xyz = d3([tv[0], tv[1], tv[2]]);
@@ -187,9 +193,9 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
             ex.bad_vertex[v] = true;
             w_par.push(cos, || {
                 ex_v(format!(
-                    "tangent {} vs normal {:?}: {:.2}° apart",
+                    "tangent {} vs normal {}: {:.2}° apart",
                     fmt_t(tv),
-                    normals[v],
+                    fmt_v(&normals[v]),
                     cos.min(1.0).acos().to_degrees()
                 ))
             });
@@ -199,7 +205,7 @@ pub fn check_vectors(d: &PrimData, ex: &mut Explained, s: &mut Subject) {
             let off = cos.min(1.0).asin().to_degrees();
             worst_skew_deg = worst_skew_deg.max(off);
             w_skew.push(cos, || {
-                ex_v(format!("tangent {} is {off:.2}° off the plane of normal {:?}", fmt_t(tv), normals[v]))
+                ex_v(format!("tangent {} is {off:.2}° off the plane of normal {}", fmt_t(tv), fmt_v(&normals[v])))
             });
         }
     }
@@ -341,7 +347,15 @@ pub fn check_degenerate(d: &PrimData, with_uvs: bool, ex: &mut Explained, s: &mu
                 zero_uv += 1;
                 ex.degenerate_tri[k] = true;
                 wu.push(1.0 / (1.0 + k as f64), || {
-                    tri_ex(format!("vertices {} {} {}, UVs {:?} {:?} {:?}", tri[0], tri[1], tri[2], t[0], t[1], t[2]))
+                    tri_ex(format!(
+                        "vertices {} {} {}, UVs {} {} {}",
+                        tri[0],
+                        tri[1],
+                        tri[2],
+                        fmt_v(&t[0]),
+                        fmt_v(&t[1]),
+                        fmt_v(&t[2])
+                    ))
                 });
             }
         }

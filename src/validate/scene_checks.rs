@@ -19,6 +19,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.mesh = Some(r.mesh);
         s.primitive = Some(r.primitive);
         let pj = scene.prim_json(r);
+        check_texcoords(scene, r, &mut s);
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
         // A compressed primitive whose normal map needs frames is a warning: its frames go
         // unchecked, and `--strict` must not pass them silently.
@@ -91,6 +92,30 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     }
     done.extend(check_images(scene, &mats));
     Ok(done)
+}
+
+/// Each texture of the primitive's material must find the UV set it reads.
+fn check_texcoords(scene: &Scene, r: PrimRef, s: &mut Subject) {
+    use crate::scene::texcoord;
+    let Some(material) = scene.material_of(r) else { return };
+    let mut textures = 0;
+    texcoord::texture_infos(material, &mut |_, _| textures += 1);
+    if textures == 0 {
+        return;
+    }
+    let attrs = scene.prim_json(r).get("attributes").and_then(|a| a.as_object());
+    let missing = texcoord::missing_sets(material, |k| attrs.is_some_and(|a| a.contains_key(&format!("TEXCOORD_{k}"))));
+    let finding = (!missing.is_empty()).then(|| {
+        let list: Vec<String> = missing.iter().map(|(tex, set)| format!("{tex} reads TEXCOORD_{set}")).collect();
+        Finding::new(
+            Code::TEXCOORD_MISSING,
+            missing.len(),
+            textures,
+            "textures",
+            format!("the primitive lacks the UV sets its material's textures read: {}", list.join(", ")),
+        )
+    });
+    s.check(Code::TEXCOORD_MISSING, finding);
 }
 
 fn prim_name(scene: &Scene, r: PrimRef) -> String {

@@ -9,12 +9,12 @@
 //! inputs that do not depend on scheduling, so the output is the same for every thread count.
 //!
 //! Stages (each a module):
-//! 1. [`triangles`]: degenerate test, first-order tangents, the reference's triangle order;
-//! 2. [`shortcut`] or [`weld`]: welded vertex ids, by hashing vertices when the representatives
+//! 1. `triangles.rs`: degenerate test, first-order tangents, the reference's triangle order;
+//! 2. `shortcut.rs` or `weld.rs`: welded vertex ids, by hashing vertices when the representatives
 //!    provably do not matter, else by replaying the legacy weld's partitioning;
-//! 3. [`neighbors`]: triangle adjacency, including the legacy sort's unpaired tail;
-//! 4. [`groups`]: orientation-consistent fans around each welded vertex;
-//! 5. [`accumulate`]: sub-groups by the angular threshold and angle-weighted sums;
+//! 3. `neighbors.rs`: triangle adjacency, including the legacy sort's unpaired tail;
+//! 4. `groups.rs`: orientation-consistent fans around each welded vertex;
+//! 5. `accumulate.rs`: sub-groups by the angular threshold and angle-weighted sums;
 //! 6. here: degenerate triangles borrow from the first good corner of the same welded vertex,
 //!    and the output is [`Frames`]: each summed value once, found through the vertex.
 //!
@@ -319,5 +319,6 @@ fn degenerate<W: Welded>(w: &W, order: &Order, ng: usize, out: &mut Builder) {
     }
 }
 
-#[cfg(test)]
+// Every test here compares with the reference engine.
+#[cfg(all(test, feature = "reference"))]
 mod tests;

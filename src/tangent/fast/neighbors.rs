@@ -6,7 +6,7 @@
 //! sort on `i0` and a small sort on `(i1, triangle)` per `i0`, and each group is paired with
 //! the same greedy rule in linear time.
 //!
-//! The quirk (MikkTSpace issue 5): the reference's quicksort leaves the edges with the largest
+//! The quirk (reported upstream as issue 5 of the C MikkTSpace repository, mmikk/MikkTSpace): the reference's quicksort leaves the edges with the largest
 //! `i0` in the order its first (unstable, `i0`-only) pass left them, only partly repaired. Edges
 //! of one key that end up apart are not paired. That tail is reproduced exactly by replaying the
 //! same seeded quicksort on the `i0` keys, but only on the sub-ranges that contain the largest

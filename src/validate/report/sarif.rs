@@ -15,6 +15,7 @@ fn description(code: Code) -> &'static str {
     use Code::*;
     match code {
         TANGENT_MISSING => "A material's normalTexture needs a tangent space and the primitive has no TANGENT.",
+        TEXCOORD_MISSING => "A material texture reads a UV set (texCoord) the primitive does not have.",
         TANGENT_UNUSED => "TANGENT is present but no normal texture reads it.",
         TANGENT_WITHOUT_NORMAL => "TANGENT without NORMAL: clients compute flat normals and must ignore the tangents.",
         TANGENT_NOT_FINITE => "A tangent holds NaN or infinity.",
@@ -28,6 +29,7 @@ fn description(code: Code) -> &'static str {
         }
         TANGENT_SEAM_SHARED => "One vertex serves triangles of both UV orientations: an unsplit mirror seam.",
         TANGENT_MIKK_ANGLE => "Stored tangents are further from the regenerated MikkTSpace frames than the threshold.",
+        TANGENT_MIKK_UNCHECKED => "The comparison with regenerated MikkTSpace frames could not run on this primitive.",
         TANGENT_MIKK_SIGN => "Stored w differs from MikkTSpace's sign on a corner no other check explains.",
         TRIANGLE_DEGENERATE => "A zero-area triangle: no tangent frame exists.",
         TRIANGLE_UV_DEGENERATE => "A triangle with zero area in the normal texture's UV space.",
