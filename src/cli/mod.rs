@@ -6,6 +6,7 @@ mod bench_batch;
 mod bench_command;
 mod bench_normalmap;
 mod bench_tangents;
+mod bench_transfer;
 mod completions;
 mod inspect;
 mod normalmap;

@@ -29,8 +29,8 @@ pub use encode::{
 pub use filter::wrap_index;
 pub use height::{height_from_image, Channel, HeightPlane};
 pub use io::{
-    convert_file, decode_normal_image, load_height, load_normal_image, open_image, png_bytes, write_normal_image,
-    Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
+    convert_file, decode_normal_image, image_bytes, load_height, load_normal_image, open_image, png_bytes,
+    write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
 pub use rows::{unit_normal, Progress};
 
