@@ -440,8 +440,7 @@ fn time_one(
         }
         peak = peak.max(super::command::peak_of(&stderr).unwrap_or(0));
         let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap_or_default();
-        let st =
-            j.pointer("/report/transfer/timings_ms/stages").and_then(|s| s.as_array()).cloned().unwrap_or_default();
+        let st = j.pointer("/transfer/timings_ms/stages").and_then(|s| s.as_array()).cloned().unwrap_or_default();
         for (k, name) in ["read high", "bvh", "rays"].iter().enumerate() {
             let ms = st.iter().find(|s| s[0] == *name).and_then(|s| s[1].as_f64()).unwrap_or(f64::NAN);
             stages[k].push(ms);

@@ -109,14 +109,23 @@ fn leaf(b: &Aabb, first: usize, n: usize) -> Node {
     Node { min: b.min.to_array(), a: first as u32, max: b.max.to_array(), n: n as u32 }
 }
 
-/// The best binned-SAH split of `items`: `(axis, bin boundary)`, or `None` when a leaf is
-/// cheaper or the centres cannot be told apart.
+/// The best binned-SAH split of `items` along the centres' longest axis: `(axis, bin boundary)`,
+/// or `None` when a leaf is cheaper or the centres cannot be told apart.
 fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<(usize, usize)> {
     let extent = c.max - c.min;
     let mut best: Option<(f32, usize, usize)> = None;
-    for axis in 0..3 {
+    // Binning along the centres' longest axis only: a third of the work of trying all three,
+    // and for HIGH's small, evenly spread triangles the trees trace as fast (measured).
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    {
         if !(extent[axis] > 0.0) {
-            continue;
+            return None;
         }
         let scale = BINS as f32 / extent[axis];
         let mut bins = [(Aabb::EMPTY, 0usize); BINS];

@@ -56,7 +56,7 @@ pub fn low(scene: &Scene, prims: &[PrimRef]) -> Result<Low> {
         let set = scene.normal_texcoord(r).unwrap_or(0);
         let p = scene.primitive(r)?;
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
-        for need in ["POSITION", "NORMAL", "TANGENT", &format!("TEXCOORD_{set}")] {
+        for need in [&format!("TEXCOORD_{set}"), "POSITION", "NORMAL", "TANGENT"] {
             if p.attr(need).is_none() {
                 return Err(scene.err(format!(
                     "{where_} has no {need}; baking from HIGH needs LOW's UV layout (give LOW UVs, or choose another material with --material)"

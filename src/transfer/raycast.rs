@@ -120,7 +120,9 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
     }
     let mut best: Option<Hit> = None;
     let (mut lo, mut hi) = (-back, front);
-    let mut stack = [0u32; 64];
+    // Nodes still to visit, with how far their part of the ray lies from the origin: a node
+    // whose gap is beyond the best hit so far is dropped without another box test.
+    let mut stack = [(0u32, 0.0f32); 96];
     let mut sp = 0;
     let root = &bvh.nodes[0];
     slab(ray, &root.min, &root.max, lo, hi)?;
@@ -149,9 +151,9 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
             let sr = slab(ray, &bvh.nodes[r].min, &bvh.nodes[r].max, lo, hi).map(|(a, b)| gap(a, b));
             match (sl, sr) {
                 (Some(a), Some(b)) => {
-                    let (first, second) = if a <= b { (l, r) } else { (r, l) };
+                    let (first, second, g) = if a <= b { (l, r, b) } else { (r, l, a) };
                     if sp < stack.len() {
-                        stack[sp] = second as u32;
+                        stack[sp] = (second as u32, g);
                         sp += 1;
                     }
                     node = first;
@@ -168,15 +170,15 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
                 (None, None) => {}
             }
         }
-        // Pop the next node that can still hold a better hit.
+        // Pop the next node that can still hold a hit as near as the best.
         loop {
             if sp == 0 {
                 return best;
             }
             sp -= 1;
-            let c = stack[sp] as usize;
-            if slab(ray, &bvh.nodes[c].min, &bvh.nodes[c].max, lo, hi).is_some() {
-                node = c;
+            let (c, g) = stack[sp];
+            if g <= hi.max(-lo) {
+                node = c as usize;
                 break;
             }
         }
