@@ -135,7 +135,8 @@ fn analytic_torus_within_targets() {
         let c: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
         c["comparison"]["normal_angle_deg"]["mean"].as_f64().unwrap()
     };
-    assert!(mean < 1.0 && mean < flat / 5.0, "preview: baked {mean:.2}° from HIGH, unbaked LOW {flat:.2}°");
+    // The renders differ by parallax too: the same pixel sees HIGH up to 0.035 off LOW.
+    assert!(mean < 2.0 && mean < flat / 5.0, "preview: baked {mean:.2}° from HIGH, unbaked LOW {flat:.2}°");
 }
 
 /// Mirrored UV islands: the left half of LOW reuses the right half's UVs flipped. HIGH is even in
@@ -186,15 +187,18 @@ fn degenerate_duplicate_and_grazing() {
         let t = DVec3::new((i as f64 * 0.7).sin() * 0.4, (j as f64 * 0.9).cos() * 0.4, 1.0).normalize();
         t.as_vec3().to_array()
     };
-    // HIGH's vertices sit exactly under texel centres: every ray passes through a vertex.
+    // HIGH's vertices sit exactly under texel centres (and one ring beyond LOW's edges): every
+    // ray passes through a vertex.
     let mut clean = Mesh::default();
-    for j in 0..n {
-        for i in 0..n {
-            clean.positions.push([(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32, 0.0]);
+    let m = n + 2;
+    for j in 0..m {
+        for i in 0..m {
+            let (x, y) = ((i as f32 - 0.5) / n as f32, (j as f32 - 0.5) / n as f32);
+            clean.positions.push([x, y, 0.0]);
             clean.normals.push(tilt(i, j));
         }
     }
-    let w = n as u32;
+    let w = m as u32;
     for j in 0..w - 1 {
         for i in 0..w - 1 {
             let a = j * w + i;
@@ -228,7 +232,7 @@ fn degenerate_duplicate_and_grazing() {
     let map = image_of(&a);
     for (k, p) in map.pixels().enumerate() {
         let (i, j) = (k % n, n - 1 - k / n);
-        let want = tilt(i, j).map(|c| ((c as f64 * 0.5 + 0.5) * 255.0).round() as i32);
+        let want = tilt(i + 1, j + 1).map(|c| ((c as f64 * 0.5 + 0.5) * 255.0).round() as i32);
         let got = p.0.map(|c| c as i32);
         assert!((0..3).all(|c| (got[c] - want[c]).abs() <= 1), "texel {i},{j}: {got:?}, HIGH's normal is {want:?}");
     }
@@ -345,8 +349,9 @@ fn bad_inputs_are_refused() {
     let no_uv = write(&v.join("nouv.glb"), &t.high(8, 4));
     let wrong_cage = write(&v.join("cage.glb"), &t.low(8, 5));
     let out = v.join("out.glb");
+    let missing = v.join("missing.glb");
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec!["bake", s(&low), "--from", s(&v.join("missing.glb")), "-o", s(&out)], "missing.glb"),
+        (vec!["bake", s(&low), "--from", s(&missing), "-o", s(&out)], "missing.glb"),
         (vec!["bake", s(&no_uv), "--from", s(&high), "-o", s(&out)], "TEXCOORD_0"),
         (vec!["bake", s(&low), "--from", s(&high), "--cage", s(&wrong_cage), "-o", s(&out)], "cage"),
         (vec!["bake", s(&low), "--from", s(&high), "--size", "0", "-o", s(&out)], "--size"),

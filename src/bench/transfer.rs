@@ -407,6 +407,7 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// Runs `exe bake low --from high` `runs` times and measures the last output.
+#[allow(clippy::too_many_arguments)]
 fn time_one(
     exe: &Path,
     dir: &Path,

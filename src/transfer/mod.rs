@@ -407,7 +407,7 @@ impl Ctx<'_> {
         let m = Mat3A::from_cols(tan, bit, nrm);
         let det = m.determinant();
         let scale = tan.length() * bit.length() * nrm.length();
-        if hn == Vec3A::ZERO || !(det.abs() > 1e-6 * scale) {
+        if hn == Vec3A::ZERO || det.is_nan() || det.abs() <= 1e-6 * scale {
             c.degenerate_frames += 1;
             return Sample { ts: Vec3A::Z, t: Some(hit.t) };
         }

@@ -164,7 +164,7 @@ mod tests {
         let tris = [
             edges([[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]),
             edges([[0.0, 0.0], [4.0, 4.0], [0.0, 4.0]]),
-            edges([[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]]),
+            edges([[0.0, 0.0], [4.1, 0.0], [0.0, 4.1]]),
         ];
         let b = band(&tris[..2], &[0, 1], 0, 4, 8, 2);
         for sy in 0..8 {
@@ -182,8 +182,9 @@ mod tests {
         }
         assert_eq!(b.overlapping, 0);
         let o = band(&tris, &[0, 1, 2], 0, 4, 8, 2);
-        // Triangle 2 overlaps half the square strictly inside: 8x8 samples, minus the diagonal.
-        assert_eq!(o.overlapping, 28);
-        assert!(o.owner.iter().all(|&t| t != 2));
+        // Triangle 2 holds the samples with x + y < 4.1 (none on its edge): 36 of the 8x8.
+        assert_eq!(o.overlapping, 36);
+        // Inside the square the first two triangles keep every sample.
+        assert!((0..8 * 16).filter(|s| s % 16 < 8).all(|s| o.owner[s] != 2));
     }
 }
