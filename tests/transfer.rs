@@ -151,7 +151,11 @@ fn mirrored_uv_islands_are_right_on_both_sides() {
     );
     let out = v.join("baked.glb");
     let rep = bake(&low, &high, &out, &["--size", "512"]);
-    assert!(counts(&rep)["overlapping_samples"].as_u64().unwrap() > 0, "the mirrored halves overlap in UV");
+    let c = counts(&rep);
+    assert!(c["overlapping_samples"].as_u64().unwrap() > 0, "the mirrored halves overlap in UV");
+    // Half the square has no island: the borders are extended, 16 rings padded, the rest flat.
+    assert!(c["extended"].as_u64().unwrap() > 0 && c["padded"].as_u64().unwrap() > 0);
+    assert!(c["uncovered"].as_u64().unwrap() > 100 * 512);
     let truth = field_truth(&bumps, DVec3::ZERO);
     let right = evaluate(&out, &truth, &|p| p.x > 0.0).unwrap();
     let left = evaluate(&out, &truth, &|p| p.x < 0.0).unwrap();
@@ -218,7 +222,13 @@ fn degenerate_duplicate_and_grazing() {
         dirty.indices.extend(&t);
         dirty.indices.extend([t[0], t[0], t[1]]);
     }
-    let low = flat_low(4, 0.0, 1.0, DVec3::new(0.0, 0.0, 0.01), &|x, y| [x as f32, (1.0 - y) as f32]);
+    let mut low = flat_low(4, 0.0, 1.0, DVec3::new(0.0, 0.0, 0.01), &|x, y| [x as f32, (1.0 - y) as f32]);
+    // One more triangle whose UVs have no area: counted, baked nowhere.
+    let k = low.positions.len() as u32;
+    low.positions.extend([[0.2, 0.2, 0.01], [0.3, 0.2, 0.01], [0.2, 0.3, 0.01]]);
+    low.normals.extend([[0.0, 0.0, 1.0]; 3]);
+    low.uvs.extend([[0.5, 0.5]; 3]);
+    low.indices.extend([k, k + 1, k + 2]);
     let low = write(&v.join("low.glb"), &low);
     let a = v.join("clean.glb");
     let b = v.join("dirty.glb");
@@ -226,6 +236,7 @@ fn degenerate_duplicate_and_grazing() {
     let ra = bake(&low, &write(&v.join("high_clean.glb"), &clean), &a, &args);
     let rb = bake(&low, &write(&v.join("high_dirty.glb"), &dirty), &b, &args);
     assert_eq!(counts(&ra)["missed_rays"], 0, "rays through HIGH's vertices slipped through");
+    assert_eq!(counts(&ra)["zero_uv_triangles"], 1);
     assert_eq!(counts(&ra), counts(&rb));
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "duplicates and degenerates changed the map");
     // LOW's frame is the world's (u along x, v up along y): each texel holds its vertex's normal.
