@@ -219,8 +219,9 @@ fn check(s: &Settings) -> Result<()> {
     if s.highs.is_empty() {
         return Err(Error::usage("bake --from: give at least one HIGH mesh"));
     }
-    if s.width == 0 || s.height == 0 || s.width > 16384 || s.height > 16384 {
-        return Err(Error::usage("--size: each side must be 1 to 16384 texels"));
+    // About 40 bytes per texel are held while baking: 8192² is 2.7 GB.
+    if s.width == 0 || s.height == 0 || s.width > 8192 || s.height > 8192 {
+        return Err(Error::usage("--size: each side must be 1 to 8192 texels"));
     }
     if !(1..=8).contains(&s.samples) {
         return Err(Error::usage("--samples: 1 to 8 (samples per texel along each axis)"));
