@@ -378,3 +378,54 @@ fn bad_inputs_are_refused() {
         assert!(!out.exists(), "{args:?} wrote output");
     }
 }
+
+/// An OBJ LOW (UVs stored v up) bakes the same map as the same LOW in glTF (v down).
+#[test]
+fn obj_low_bakes_like_gltf_low() {
+    let v = validated_dir("transfer_obj");
+    let high = write(&v.join("high.glb"), &field_high(&bumps, 200, 0.0, 1.0, DVec3::ZERO));
+    let low = flat_low(6, 0.0, 1.0, DVec3::ZERO, &|x, y| [(0.1 + 0.8 * x) as f32, (0.1 + 0.8 * (1.0 - y)) as f32]);
+    let glb = write(&v.join("low.glb"), &low);
+    let mut obj = String::new();
+    for (p, (n, t)) in low.positions.iter().zip(low.normals.iter().zip(&low.uvs)) {
+        obj += &format!("v {} {} {}\nvn {} {} {}\nvt {} {}\n", p[0], p[1], p[2], n[0], n[1], n[2], t[0], 1.0 - t[1]);
+    }
+    for t in low.indices.chunks_exact(3) {
+        let [a, b, c] = [t[0] + 1, t[1] + 1, t[2] + 1];
+        obj += &format!("f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}\n");
+    }
+    let obj_path = scratch_dir("transfer_obj").join("low.obj");
+    std::fs::write(&obj_path, obj).unwrap();
+    let (a, b) = (v.join("from_glb.glb"), v.join("from_obj.glb"));
+    bake(&glb, &high, &a, &["--size", "128"]);
+    bake(&obj_path, &high, &b, &["--size", "128"]);
+    let (ia, ib) = (image_of(&a), image_of(&b));
+    let worst = ia
+        .pixels()
+        .zip(ib.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| (p.0[c] as i32 - q.0[c] as i32).abs()))
+        .max();
+    assert!(worst.unwrap() <= 1, "maps differ by up to {worst:?}");
+    let e = evaluate(&b, &field_truth(&bumps, DVec3::ZERO), &|_| true).unwrap();
+    assert_within(&e, 0.4, 0.9, "OBJ LOW");
+}
+
+/// HIGH split over two files (`--from` twice) bakes the same map as HIGH in one file.
+#[test]
+fn several_high_files_bake_as_one() {
+    let v = validated_dir("transfer_two_highs");
+    let whole = field_high(&bumps, 120, 0.0, 1.0, DVec3::ZERO);
+    let half = whole.indices.len() / 6 * 3;
+    let (mut first, mut second) = (whole.clone(), whole.clone());
+    first.indices.truncate(half);
+    second.indices.drain(..half);
+    let h = write(&v.join("high.glb"), &whole);
+    let h1 = write(&v.join("high1.glb"), &first);
+    let h2 = write(&v.join("high2.glb"), &second);
+    let low = write(&v.join("low.glb"), &flat_low(4, 0.0, 1.0, DVec3::ZERO, &|x, y| [x as f32, (1.0 - y) as f32]));
+    let (a, b) = (v.join("one.glb"), v.join("two.glb"));
+    bake(&low, &h, &a, &["--size", "96"]);
+    let rep = bake(&low, &h1, &b, &["--size", "96", "--from", s(&h2)]);
+    assert_eq!(rep["transfer"]["high"].as_array().unwrap().len(), 2);
+    assert_eq!(image_of(&a), image_of(&b));
+}
