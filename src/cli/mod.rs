@@ -32,7 +32,7 @@ pub enum Command {
     /// Convert a height map into a tangent-space normal map.
     Normalmap(normalmap::Args),
     /// Mesh + height or normal map -> a render-ready glTF with nothing it does not need.
-    Bake(bake::Args),
+    Bake(Box<bake::Args>),
     /// Measure error against run time.
     Bench(bench::Args),
     /// Check tangent frames, handedness and normal maps; exit 1 on errors (for CI).
@@ -52,7 +52,7 @@ pub fn run(cli: Cli) -> Result<u8> {
     match cli.command {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),
-        Command::Bake(a) => bake::run(a),
+        Command::Bake(a) => bake::run(*a),
         Command::Bench(a) => bench::run(a),
         Command::Validate(a) => validate::run(a),
         Command::Inspect(a) => inspect::run(a),
