@@ -31,7 +31,7 @@ pub enum Command {
     Tangents(tangents::Args),
     /// Convert a height map into a tangent-space normal map.
     Normalmap(normalmap::Args),
-    /// Mesh + height or normal map -> a render-ready glTF with nothing it does not need.
+    /// Mesh + height map, normal map or high-poly mesh (--from) -> a render-ready glTF with nothing it does not need.
     Bake(Box<bake::Args>),
     /// Measure error against run time.
     Bench(bench::Args),
