@@ -9,6 +9,7 @@
 //! - [`normalmap`]: height maps to tangent-space normal maps.
 //! - [`validate`]: tangent-frame, handedness and normal-map checks.
 //! - [`preview`]: a CPU renderer of the reference shading model (`shaders/` in GLSL).
+//! - [`transfer`]: high-poly to low-poly normal-map baking (`bake --from`).
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
 //! - [`bench`](mod@bench): error against run time (`bumpbake bench ...`).
 
@@ -23,6 +24,7 @@ pub mod preview;
 pub mod report;
 pub mod scene;
 pub mod tangent;
+pub mod transfer;
 pub mod validate;
 
 pub use error::{Error, Result};

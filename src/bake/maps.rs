@@ -143,3 +143,20 @@ pub fn attach(scene: &mut Scene, m: usize, png: &[u8], name: &str) {
     let t = scene.push_texture(img, sampler);
     scene.set_normal_texture(m, t);
 }
+
+/// A 1x1 flat normal map.
+pub fn flat_png() -> Vec<u8> {
+    let img = image::RgbImage::from_pixel(1, 1, image::Rgb([128, 128, 255]));
+    encode(image::DynamicImage::ImageRgb8(img)).expect("a 1x1 PNG encodes")
+}
+
+/// Puts `png` in place of the image material `m`'s normal texture shows (its name kept).
+pub fn replace_normal_image(scene: &mut Scene, m: usize, png: &[u8]) {
+    let Some(t) = scene.json["materials"][m].pointer("/normalTexture/index").and_then(|t| t.as_u64()) else { return };
+    let Some(img) = scene.texture_image(t as usize) else { return };
+    let name = scene.json["images"][img].get("name").and_then(|n| n.as_str()).map(String::from);
+    let new = scene.push_image(png, "image/png", name.as_deref());
+    let images = crate::scene::array_mut(&mut scene.json, "images");
+    images.swap(img, new);
+    images.pop();
+}

@@ -23,6 +23,8 @@ pub enum MapSource {
     Scene,
     Height(PathBuf),
     Normal(PathBuf),
+    /// Baked from high-poly meshes onto the scene's UV layout ([`crate::transfer`]).
+    Transfer(Box<crate::transfer::Settings>),
 }
 
 #[derive(Debug, Clone, Default)]
@@ -65,6 +67,9 @@ pub struct BakeReport {
     /// Maps that came out (nearly) flat, with a strength that would show their relief.
     pub warnings: Vec<String>,
     pub timings_ms: Timings,
+    /// What `--from` baking did, when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub transfer: Option<crate::transfer::TransferReport>,
 }
 
 pub fn run(job: &BakeJob) -> Result<BakeReport> {
@@ -84,6 +89,16 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
             },
         )
     })?;
+    let transfer = match &job.map {
+        MapSource::Transfer(ts) => {
+            deps.extend(ts.highs.iter().chain(ts.cage.iter()).cloned());
+            let mats: Vec<usize> = targets.iter().map(|m| m.material).collect();
+            let baked = t.time("transfer", || crate::transfer::bake_materials(&scene, &mats, ts))?;
+            mats.iter().for_each(|&m| maps::replace_normal_image(&mut scene, m, &baked.png));
+            Some((baked.report, baked.files))
+        }
+        _ => None,
+    };
     let removed = if job.keep_all {
         Vec::new()
     } else {
@@ -92,6 +107,9 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
     let (mut files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &deps));
+    }
+    if let Some((_, extra)) = &transfer {
+        extra.iter().for_each(|(p, b)| files.add(p, b.clone()));
     }
     t.time("write", || files.commit())?;
     Ok(BakeReport {
@@ -105,6 +123,7 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
         notes: scene.notes.clone(),
         warnings,
         timings_ms: t,
+        transfer: transfer.map(|(r, _)| r),
     })
 }
 
@@ -195,6 +214,12 @@ fn attach_maps(
         let name = names[m].clone();
         let label = format!("{}_normal", name.clone().unwrap_or_else(|| format!("material{m}")));
         match &job.map {
+            MapSource::Transfer(ts) => {
+                // The map is baked once tangents exist; a flat texel holds its place until then.
+                maps::attach(scene, m, &maps::flat_png(), &label);
+                let file = ts.highs.first().cloned();
+                out.push(MaterialMap { material: m, name, source: "high", file, convention: None });
+            }
             MapSource::Height(p) | MapSource::Normal(p) => {
                 if made.is_none() {
                     made = Some(match &job.map {
@@ -270,6 +295,9 @@ impl BakeReport {
         }
         for w in &self.warnings {
             s += &format!("  warning: {w}\n");
+        }
+        if let Some(tr) = &self.transfer {
+            s += &tr.text();
         }
         let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
         s += &format!("  time: {}\n", times.join(", "));

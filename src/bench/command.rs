@@ -66,7 +66,7 @@ pub fn run(exe: &Path, input: &Path, dir: &Path, runs: usize) -> Result<CommandB
 }
 
 /// The largest `peak N kB` of the `memtrace` lines.
-fn peak_of(stderr: &str) -> Option<u64> {
+pub(crate) fn peak_of(stderr: &str) -> Option<u64> {
     stderr
         .lines()
         .filter(|l| l.starts_with("memtrace "))

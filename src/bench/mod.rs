@@ -8,3 +8,4 @@ pub mod plot;
 pub mod surfaces;
 pub mod tangents;
 pub mod tangents_plot;
+pub mod transfer;

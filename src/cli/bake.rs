@@ -5,6 +5,7 @@ use bumpbake::bake::{run as run_job, BakeJob, BakeReport, MapSource};
 use bumpbake::batch;
 use bumpbake::normalmap::{Channel, Convention, Filter};
 use bumpbake::scene::{ReadOptions, WriteOptions};
+use bumpbake::transfer::Settings;
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -12,13 +13,44 @@ use std::path::{Path, PathBuf};
 #[command(after_help = "Examples:
   bumpbake bake fixtures/bake/torus.obj -o torus.glb
   bumpbake bake scene.gltf --height bumps.png --material Stone --strength 4 -o scene.glb
-  bumpbake bake model.obj --normal normal_dx.png --convention directx -o model.gltf --images external")]
+  bumpbake bake model.obj --normal normal_dx.png --convention directx -o model.gltf --images external
+  bumpbake bake low.glb --from sculpt.glb -o low_baked.glb --size 2048 --samples 2 --miss-mask misses.png")]
 pub struct Args {
     #[command(flatten)]
     pub io: super::report::MeshIo,
     /// Height map to convert into the normal map (PNG, JPEG, WebP, TIFF or EXR).
-    #[arg(long, conflicts_with = "normal")]
+    #[arg(long, conflicts_with_all = ["normal", "from"])]
     pub height: Option<PathBuf>,
+    /// High-poly mesh to bake the normal map from, onto the input's UV layout (repeatable).
+    #[arg(long, conflicts_with = "normal")]
+    pub from: Vec<PathBuf>,
+    /// With --from: a cage (the input with its vertices moved out); rays run from LOW towards it.
+    #[arg(long, requires = "from")]
+    pub cage: Option<PathBuf>,
+    /// With --from: how far rays reach outside LOW, scene units (default 5% of LOW's diagonal).
+    #[arg(long, requires = "from")]
+    pub ray_front: Option<f64>,
+    /// With --from: how far rays reach inside LOW, scene units (default 5% of LOW's diagonal).
+    #[arg(long, requires = "from")]
+    pub ray_back: Option<f64>,
+    /// With --from: N x N rays per texel.
+    #[arg(long, default_value_t = 1, requires = "from")]
+    pub samples: usize,
+    /// With --from: map size, N or WxH.
+    #[arg(long, default_value = "1024", requires = "from")]
+    pub size: String,
+    /// With --from: texels of padding around UV islands.
+    #[arg(long, default_value_t = 16, requires = "from")]
+    pub padding: usize,
+    /// With --from: also write the map to this file (.png, .tif, .exr; --convention, --bits16).
+    #[arg(long, requires = "from")]
+    pub map_out: Option<PathBuf>,
+    /// With --from: write the height map (signed distance LOW to HIGH, 16-bit PNG).
+    #[arg(long, requires = "from")]
+    pub height_out: Option<PathBuf>,
+    /// With --from: write where rays missed HIGH (8-bit PNG, white: every ray of the texel missed).
+    #[arg(long, requires = "from")]
+    pub miss_mask: Option<PathBuf>,
     /// Normal map to attach (PNG/JPEG kept, WebP/TIFF/EXR stored as PNG; DirectX converted to glTF's +Y).
     #[arg(long)]
     pub normal: Option<PathBuf>,
@@ -51,7 +83,7 @@ pub struct Args {
     /// Write 16-bit normal maps.
     #[arg(long)]
     pub bits16: bool,
-    /// Green-channel convention of --normal (default: detect it).
+    /// Green-channel convention of --normal (default: detect it), or of --map-out.
     #[arg(long, value_enum)]
     pub convention: Option<Convention>,
     /// Keep everything, even what nothing uses.
@@ -77,12 +109,14 @@ pub fn run(a: Args) -> Result<u8> {
     if !strength.is_finite() {
         return Err(Error::usage("--strength must be finite"));
     }
+    let transfer = transfer_settings(&a)?;
     let job = |input: &Path, output: &Path| BakeJob {
         mesh: input.to_path_buf(),
         output: output.to_path_buf(),
-        map: match (&a.height, &a.normal) {
-            (Some(h), _) => MapSource::Height(h.clone()),
-            (None, Some(n)) => MapSource::Normal(n.clone()),
+        map: match (&a.height, &a.normal, &transfer) {
+            (_, _, Some(t)) => MapSource::Transfer(Box::new(t.clone())),
+            (Some(h), _, _) => MapSource::Height(h.clone()),
+            (None, Some(n), _) => MapSource::Normal(n.clone()),
             _ => MapSource::Scene,
         },
         material: a.material.clone(),
@@ -94,7 +128,7 @@ pub fn run(a: Args) -> Result<u8> {
             sixteen_bit: a.bits16,
             ..Default::default()
         },
-        normal_convention: a.convention,
+        normal_convention: if transfer.is_some() { None } else { a.convention },
         keep_all: a.keep_all,
         bitangents: a.bitangents,
         read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
@@ -106,4 +140,43 @@ pub fn run(a: Args) -> Result<u8> {
         run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
     })?;
     super::report::print("bumpbake-bake/1", &a.io.inputs, results, a.batch.json, a.batch.quiet, BakeReport::text)
+}
+
+/// The `--from` options, checked; `None` without `--from`.
+fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
+    if a.from.is_empty() {
+        return Ok(None);
+    }
+    let files = [&a.map_out, &a.height_out, &a.miss_mask];
+    if a.io.inputs.len() > 1 && files.iter().any(|f| f.is_some()) {
+        return Err(Error::usage("--map-out, --height-out and --miss-mask take one input"));
+    }
+    let (width, height) = parse_size(&a.size)?;
+    Ok(Some(Settings {
+        highs: a.from.clone(),
+        cage: a.cage.clone(),
+        ray_front: a.ray_front,
+        ray_back: a.ray_back,
+        samples: a.samples,
+        width,
+        height,
+        padding: a.padding,
+        sixteen_bit: a.bits16,
+        map_out: a.map_out.clone(),
+        convention: a.convention.unwrap_or_default(),
+        height_out: a.height_out.clone(),
+        miss_mask: a.miss_mask.clone(),
+        read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
+        progress: a.io.inputs.len() == 1 && batch::progress_wanted(a.batch.progress, a.batch.quiet || a.batch.json),
+    }))
+}
+
+/// `N` or `WxH`.
+fn parse_size(s: &str) -> Result<(usize, usize)> {
+    let bad = || Error::usage(format!("--size {s}: give N or WxH (e.g. 2048 or 2048x1024)"));
+    let num = |t: &str| t.trim().parse::<usize>().map_err(|_| bad());
+    match s.split_once(['x', 'X']) {
+        Some((w, h)) => Ok((num(w)?, num(h)?)),
+        None => num(s).map(|n| (n, n)),
+    }
 }

@@ -1,6 +1,6 @@
 //! `bumpbake bench ...`: error against run time for each stage.
 
-use super::{bench_batch, bench_command, bench_normalmap, bench_tangents};
+use super::{bench_batch, bench_command, bench_normalmap, bench_tangents, bench_transfer};
 use bumpbake::{Error, Result};
 use clap::Subcommand;
 use std::path::Path;
@@ -25,6 +25,8 @@ pub enum What {
     Batch(bench_batch::BenchBatchArgs),
     /// The whole `tangents` command on a file: time and peak memory.
     Command(bench_command::BenchCommandArgs),
+    /// `bake --from` on an analytic surface: error against time, time against HIGH and map size.
+    Transfer(bench_transfer::BenchTransferArgs),
 }
 
 pub fn run(args: Args) -> Result<u8> {
@@ -33,6 +35,7 @@ pub fn run(args: Args) -> Result<u8> {
         What::Tangents(a) => bench_tangents::run(a),
         What::Batch(a) => bench_batch::run(a),
         What::Command(a) => bench_command::run(a),
+        What::Transfer(a) => bench_transfer::run(a),
     }
 }
 

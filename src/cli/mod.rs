@@ -9,6 +9,7 @@ mod bench_batch;
 mod bench_command;
 mod bench_normalmap;
 mod bench_tangents;
+mod bench_transfer;
 mod completions;
 mod inspect;
 mod normalmap;
@@ -33,8 +34,8 @@ pub enum Command {
     Tangents(tangents::Args),
     /// Convert a height map into a tangent-space normal map.
     Normalmap(normalmap::Args),
-    /// Mesh + height or normal map -> a render-ready glTF with nothing it does not need.
-    Bake(bake::Args),
+    /// Mesh + height map, normal map or high-poly mesh (--from) -> a render-ready glTF with nothing it does not need.
+    Bake(Box<bake::Args>),
     /// Measure error against run time.
     Bench(bench::Args),
     /// Check tangent frames, handedness and normal maps; exit 1 on errors (for CI).
@@ -54,7 +55,7 @@ pub fn run(cli: Cli) -> Result<u8> {
     match cli.command {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),
-        Command::Bake(a) => bake::run(a),
+        Command::Bake(a) => bake::run(*a),
         Command::Bench(a) => bench::run(a),
         Command::Validate(a) => validate::run(a),
         Command::Inspect(a) => inspect::run(a),

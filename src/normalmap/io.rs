@@ -260,7 +260,8 @@ pub fn png_bytes(img: &NormalImage, settings: PngSettings) -> std::result::Resul
     Ok(out)
 }
 
-fn image_bytes(img: &NormalImage, format: OutputFormat, png: PngSettings) -> std::result::Result<Vec<u8>, String> {
+/// The bytes of a normal map in `format` (PNG, TIFF or EXR; EXR takes float maps only).
+pub fn image_bytes(img: &NormalImage, format: OutputFormat, png: PngSettings) -> std::result::Result<Vec<u8>, String> {
     let (w, h) = (img.width as u32, img.height as u32);
     let rgba = img.channels == 4;
     match (format, &img.data) {

@@ -31,8 +31,8 @@ pub use encode::{
 pub use filter::wrap_index;
 pub use height::{height_from_image, Channel, HeightPlane};
 pub use io::{
-    colour_words, convert_file, decode_normal_image, load_height, load_normal_image, open_image, png_bytes,
-    write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
+    colour_words, convert_file, decode_normal_image, image_bytes, load_height, load_normal_image, open_image,
+    png_bytes, write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
 pub use relief::{flat_warning, steepest_slope};
 pub use rows::{unit_normal, Progress};

@@ -1,0 +1,533 @@
+//! `bake LOW --from HIGH`: HIGH's surface detail baked into a normal map over LOW's UV layout.
+//!
+//! For every sample of every texel LOW's UV triangles cover ([`raster`]), a ray leaves LOW's
+//! surface along its interpolated smooth normal (or towards the cage) and the hit nearest LOW
+//! within `[-back, front]` is found in a BVH over HIGH ([`bvh`], [`raycast`]). HIGH's
+//! interpolated normal there is written in the tangent frame a renderer rebuilds from the
+//! `NORMAL`, `TANGENT` and `w` bumpbake writes into OUT, interpolated per pixel and not
+//! normalised (`B = w * cross(N, T)`, the MikkTSpace pixel-shader convention): the map decodes
+//! to HIGH's normal exactly, up to the encoding's rounding. Islands are padded ([`pad`]).
+
+pub mod bvh;
+pub mod mesh;
+pub mod pad;
+pub mod raster;
+pub mod raycast;
+
+use crate::error::{Error, Result};
+use crate::normalmap::{self, Convention, Depth, NormalData, NormalImage, PngSettings};
+use crate::report::Timings;
+use crate::scene::{PrimRef, ReadOptions, Scene};
+use glam::{Mat3A, Vec3A};
+use mesh::{High, Low};
+use raster::{Edges, UvTri};
+use rayon::prelude::*;
+use std::path::PathBuf;
+
+/// Default ray reach on each side of LOW, as a fraction of LOW's bounding-box diagonal.
+pub const DEFAULT_REACH: f64 = 0.05;
+/// Texel rows rasterised together.
+const BAND: usize = 8;
+
+#[derive(Debug, Clone)]
+pub struct Settings {
+    pub highs: Vec<PathBuf>,
+    pub cage: Option<PathBuf>,
+    /// Reach outside LOW (along the normal), scene units; default [`DEFAULT_REACH`].
+    pub ray_front: Option<f64>,
+    /// Reach inside LOW.
+    pub ray_back: Option<f64>,
+    /// Samples per texel along each axis (`n x n` rays per texel).
+    pub samples: usize,
+    pub width: usize,
+    pub height: usize,
+    pub padding: usize,
+    pub sixteen_bit: bool,
+    /// Also write the map to this file (PNG, TIFF or EXR), in `convention`.
+    pub map_out: Option<PathBuf>,
+    pub convention: Convention,
+    pub height_out: Option<PathBuf>,
+    pub miss_mask: Option<PathBuf>,
+    pub read: ReadOptions,
+    /// Draw a progress bar on stderr.
+    pub progress: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            highs: Vec::new(),
+            cage: None,
+            ray_front: None,
+            ray_back: None,
+            samples: 1,
+            width: 1024,
+            height: 1024,
+            padding: 16,
+            sixteen_bit: false,
+            map_out: None,
+            convention: Convention::Opengl,
+            height_out: None,
+            miss_mask: None,
+            read: ReadOptions::default(),
+            progress: false,
+        }
+    }
+}
+
+/// Counts of what happened, per texel unless named otherwise.
+#[derive(Debug, Clone, Default, serde::Serialize, PartialEq)]
+pub struct Counts {
+    /// Texels with a sample inside a UV triangle.
+    pub covered: usize,
+    /// Texels just outside an island, filled by continuing its border triangle.
+    pub extended: usize,
+    pub padded: usize,
+    /// Texels left flat: no triangle and no island within the padding.
+    pub uncovered: usize,
+    pub rays: usize,
+    /// Rays that met nothing within reach: their samples are flat.
+    pub missed_rays: usize,
+    pub texels_with_misses: usize,
+    /// Samples inside two or more UV triangles (the lowest-numbered triangle is baked).
+    pub overlapping_samples: usize,
+    /// LOW triangles without UV area (nothing to bake them into).
+    pub zero_uv_triangles: usize,
+    /// Hits whose normal faces away from LOW's side (tangent-space z < 0): clamped to z = 0.
+    pub clamped_below: usize,
+    /// Samples where LOW's frame is degenerate (zero normal or tangent): flat.
+    pub degenerate_frames: usize,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct HighFile {
+    pub file: PathBuf,
+    pub triangles: usize,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct TransferReport {
+    pub high: Vec<HighFile>,
+    pub cage: Option<PathBuf>,
+    pub low_triangles: usize,
+    pub width: usize,
+    pub height: usize,
+    pub samples_per_texel: usize,
+    pub ray_front: f64,
+    pub ray_back: f64,
+    pub counts: Counts,
+    /// Signed distance from LOW to HIGH along the rays (scene units) over all hits.
+    pub height_range: Option<[f32; 2]>,
+    pub bvh_nodes: usize,
+    pub timings_ms: Timings,
+}
+
+/// What the bake made: the map (glTF convention, PNG) and any extra files asked for.
+pub struct Baked {
+    pub png: Vec<u8>,
+    pub files: Vec<(PathBuf, Vec<u8>)>,
+    pub report: TransferReport,
+}
+
+/// Progress callback: `(bands done, bands in all)`.
+pub type Progress<'a> = Option<&'a (dyn Fn(usize, usize) + Sync)>;
+
+/// Per texel, what its samples gave.
+#[derive(Clone, Copy, Default)]
+struct Texel {
+    normal: [f32; 3],
+    /// 0: nothing, 1: extended, 2: covered.
+    state: u8,
+    samples: u16,
+    missed: u16,
+    height: f32,
+    hits: u16,
+}
+
+/// Bakes HIGH into every triangle primitive of LOW whose material is one of `materials`, with
+/// a progress bar when `s.progress` asks for one.
+pub fn bake_materials(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
+    let prims: Vec<PrimRef> = scene
+        .primitives()
+        .into_iter()
+        .filter(|&r| {
+            let mat = scene.prim_json(r).get("material").and_then(|m| m.as_u64());
+            mat.map(|m| materials.contains(&(m as usize))).unwrap_or(false) && mesh::is_triangles(scene, r)
+        })
+        .collect();
+    let bar = if s.progress {
+        let b = indicatif::ProgressBar::new(s.height as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("bake --from [{bar:40}] {pos}/{len} rows ({elapsed})")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let tick = |done: usize, all: usize| bar.set_position((done * s.height / all.max(1)) as u64);
+    let r = bake(scene, &prims, s, Some(&tick));
+    bar.finish_and_clear();
+    r
+}
+
+/// Bakes HIGH into LOW's primitives `prims` (which must carry tangents already).
+pub fn bake(scene: &Scene, prims: &[PrimRef], s: &Settings, progress: Progress) -> Result<Baked> {
+    check(s)?;
+    let mut t = Timings::default();
+    let low = t.time("low", || mesh::low(scene, prims))?;
+    let mut low = low;
+    if let Some(c) = &s.cage {
+        low.cage = Some(t.time("cage", || mesh::cage(c, &s.read, &low))?);
+    }
+    let (high, counts) = t.time("read high", || mesh::high(&s.highs, &s.read, low.origin))?;
+    crate::report::mem_mark("transfer read");
+    let High { corners, normals, normal_index } = high;
+    let bvh = t.time("bvh", || bvh::Bvh::build(&corners));
+    drop(corners);
+    crate::report::mem_mark("transfer bvh");
+    let front = s.ray_front.unwrap_or(DEFAULT_REACH * low.diagonal);
+    let back = s.ray_back.unwrap_or(DEFAULT_REACH * low.diagonal);
+    let ctx = Ctx { low: &low, bvh: &bvh, normals: &normals, normal_index: &normal_index, front, back };
+    let (texels, mut c) = t.time("rays", || ctx.trace(s, progress));
+    crate::report::mem_mark("transfer rays");
+    let (w, h) = (s.width, s.height);
+    let mut n: Vec<[f32; 3]> = texels.iter().map(|x| x.normal).collect();
+    let mut filled: Vec<bool> = texels.iter().map(|x| x.state > 0).collect();
+    c.padded = t.time("pad", || pad::pad(w, h, &mut n, &mut filled, s.padding));
+    c.uncovered = filled.iter().filter(|&&f| !f).count();
+    let (png, files, height_range) = t.time("encode", || encode(s, &texels, &n))?;
+    let report = TransferReport {
+        high: s.highs.iter().zip(counts).map(|(f, n)| HighFile { file: f.clone(), triangles: n }).collect(),
+        cage: s.cage.clone(),
+        low_triangles: low.triangles.len(),
+        width: w,
+        height: h,
+        samples_per_texel: s.samples * s.samples,
+        ray_front: front,
+        ray_back: back,
+        counts: c,
+        height_range,
+        bvh_nodes: bvh.nodes.len(),
+        timings_ms: t,
+    };
+    Ok(Baked { png, files, report })
+}
+
+fn check(s: &Settings) -> Result<()> {
+    if s.highs.is_empty() {
+        return Err(Error::usage("bake --from: give at least one HIGH mesh"));
+    }
+    // About 40 bytes per texel are held while baking: 8192² is 2.7 GB.
+    if s.width == 0 || s.height == 0 || s.width > 8192 || s.height > 8192 {
+        return Err(Error::usage("--size: each side must be 1 to 8192 texels"));
+    }
+    if !(1..=8).contains(&s.samples) {
+        return Err(Error::usage("--samples: 1 to 8 (samples per texel along each axis)"));
+    }
+    for (name, v) in [("--ray-front", s.ray_front), ("--ray-back", s.ray_back)] {
+        if let Some(v) = v {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::usage(format!("{name} must be a distance >= 0")));
+            }
+        }
+    }
+    Ok(())
+}
+
+struct Ctx<'a> {
+    low: &'a Low,
+    bvh: &'a bvh::Bvh,
+    normals: &'a [Vec3A],
+    normal_index: &'a [[u32; 3]],
+    front: f64,
+    back: f64,
+}
+
+/// What one ray gave: the tangent-space normal and the signed distance to HIGH, if it hit.
+struct Sample {
+    ts: Vec3A,
+    t: Option<f32>,
+}
+
+impl Ctx<'_> {
+    fn trace(&self, s: &Settings, progress: Progress) -> (Vec<Texel>, Counts) {
+        let (w, h, n) = (s.width, s.height, s.samples);
+        let low = self.low;
+        let mut c = Counts::default();
+        let edges: Vec<Option<Edges>> = low
+            .triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|i| {
+                    let uv = low.uvs[i as usize];
+                    [uv[0] * w as f32, uv[1] * h as f32]
+                });
+                Edges::new(&UvTri { p })
+            })
+            .collect();
+        c.zero_uv_triangles = edges.iter().filter(|e| e.is_none()).count();
+        let bands = h.div_ceil(BAND);
+        let mut per_band: Vec<Vec<u32>> = vec![Vec::new(); bands];
+        for (i, e) in edges.iter().enumerate() {
+            let Some(e) = e else { continue };
+            if !(e.max[1] >= 0.0 && e.min[1] < h as f32 && e.max[0] >= 0.0 && e.min[0] < w as f32) {
+                continue;
+            }
+            let b0 = (e.min[1].max(0.0) as usize / BAND).min(bands - 1);
+            let b1 = (e.max[1].max(0.0) as usize / BAND).min(bands - 1);
+            (b0..=b1).for_each(|b| per_band[b].push(i as u32));
+        }
+        let mut texels = vec![Texel::default(); w * h];
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let band_counts: Vec<Counts> = texels
+            .par_chunks_mut(BAND * w)
+            .enumerate()
+            .map(|(b, out)| {
+                let y0 = b * BAND;
+                let y1 = (y0 + BAND).min(h);
+                let r = self.band(&edges, &per_band[b], y0, y1, w, n, out);
+                if let Some(p) = progress {
+                    p(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, bands);
+                }
+                r
+            })
+            .collect();
+        for b in band_counts {
+            c.rays += b.rays;
+            c.missed_rays += b.missed_rays;
+            c.overlapping_samples += b.overlapping_samples;
+            c.clamped_below += b.clamped_below;
+            c.degenerate_frames += b.degenerate_frames;
+        }
+        for x in &texels {
+            match x.state {
+                2 => c.covered += 1,
+                1 => c.extended += 1,
+                _ => {}
+            }
+            c.texels_with_misses += (x.missed > 0) as usize;
+        }
+        (texels, c)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn band(
+        &self,
+        edges: &[Option<Edges>],
+        cand: &[u32],
+        y0: usize,
+        y1: usize,
+        w: usize,
+        n: usize,
+        out: &mut [Texel],
+    ) -> Counts {
+        let mut c = Counts::default();
+        let samples = raster::band(edges, cand, y0, y1, w, n);
+        c.overlapping_samples = samples.overlapping;
+        let sw = w * n;
+        let mut sums = vec![Vec3A::ZERO; out.len()];
+        for (s, &t) in samples.owner.iter().enumerate() {
+            if t == u32::MAX {
+                continue;
+            }
+            let (sx, sy) = (s % sw, s / sw);
+            let (x, y) = raster::sample_pos(sx, sy, y0, n);
+            let texel = (sy / n) * w + sx / n;
+            let e = edges[t as usize].as_ref().expect("owners have edges");
+            let r = self.sample(t as usize, e.bary(x, y), &mut c);
+            let o = &mut out[texel];
+            o.state = o.state.max(if samples.inside(s) { 2 } else { 1 });
+            o.samples += 1;
+            sums[texel] += r.ts;
+            match r.t {
+                Some(d) => {
+                    o.height += d;
+                    o.hits += 1;
+                }
+                None => o.missed += 1,
+            }
+        }
+        for (o, s) in out.iter_mut().zip(sums) {
+            if o.samples > 0 {
+                let v = s.normalize_or(Vec3A::Z);
+                o.normal = v.to_array();
+                if o.hits > 0 {
+                    o.height /= o.hits as f32;
+                }
+            }
+        }
+        c
+    }
+
+    /// One ray from LOW triangle `t` at barycentrics `b`.
+    fn sample(&self, t: usize, b: [f32; 3], c: &mut Counts) -> Sample {
+        let low = self.low;
+        let tri = low.triangles[t];
+        let mix = |f: &dyn Fn(usize) -> Vec3A| {
+            f(tri[0] as usize) * b[0] + f(tri[1] as usize) * b[1] + f(tri[2] as usize) * b[2]
+        };
+        let p = mix(&|i| low.positions[i]);
+        let nrm = mix(&|i| low.normals[i]);
+        let tan = mix(&|i| Vec3A::from_slice(&low.tangents[i][..3]));
+        let w = low.tangents[tri[0] as usize][3] * b[0]
+            + low.tangents[tri[1] as usize][3] * b[1]
+            + low.tangents[tri[2] as usize][3] * b[2];
+        let sign = if w < 0.0 { -1.0 } else { 1.0 };
+        c.rays += 1;
+        let flat = Sample { ts: Vec3A::Z, t: None };
+        let Some(nhat) = nrm.try_normalize() else {
+            c.degenerate_frames += 1;
+            c.missed_rays += 1;
+            return flat;
+        };
+        let (dir, front, back) = match &low.cage {
+            Some(cage) => {
+                let q = cage[t][0] * b[0] + cage[t][1] * b[1] + cage[t][2] * b[2];
+                let d = q - p;
+                let len = d.length();
+                if len > 1e-7 * low.diagonal as f32 {
+                    (d / len, len, self.back as f32)
+                } else {
+                    (nhat, 0.0, self.back as f32)
+                }
+            }
+            None => (nhat, self.front as f32, self.back as f32),
+        };
+        let Some(hit) = raycast::nearest(self.bvh, &raycast::Ray::new(p, dir), back, front) else {
+            c.missed_rays += 1;
+            return flat;
+        };
+        let ni = self.normal_index[hit.id as usize];
+        let hn = (self.normals[ni[0] as usize] * hit.bary[0]
+            + self.normals[ni[1] as usize] * hit.bary[1]
+            + self.normals[ni[2] as usize] * hit.bary[2])
+            .normalize_or_zero();
+        let bit = nrm.cross(tan) * sign;
+        let m = Mat3A::from_cols(tan, bit, nrm);
+        let det = m.determinant();
+        let scale = tan.length() * bit.length() * nrm.length();
+        if hn == Vec3A::ZERO || det.is_nan() || det.abs() <= 1e-6 * scale {
+            c.degenerate_frames += 1;
+            return Sample { ts: Vec3A::Z, t: Some(hit.t) };
+        }
+        let mut ts = (m.inverse() * hn).normalize_or(Vec3A::Z);
+        if ts.z < 0.0 {
+            c.clamped_below += 1;
+            ts.z = 0.0;
+            ts = ts.normalize_or(Vec3A::Z);
+        }
+        Sample { ts, t: Some(hit.t) }
+    }
+}
+
+/// The map as PNG (glTF convention), and the extra files asked for.
+#[allow(clippy::type_complexity)]
+fn encode(
+    s: &Settings,
+    texels: &[Texel],
+    n: &[[f32; 3]],
+) -> Result<(Vec<u8>, Vec<(PathBuf, Vec<u8>)>, Option<[f32; 2]>)> {
+    let (w, h) = (s.width, s.height);
+    let img = |depth: Depth, dx: bool| {
+        let ny = |v: f32| if dx { -v } else { v };
+        let data = match depth {
+            Depth::Bits8 => {
+                NormalData::U8(n.iter().flat_map(|v| [v[0], ny(v[1]), v[2]].map(normalmap::quantize8)).collect())
+            }
+            Depth::Bits16 => {
+                NormalData::U16(n.iter().flat_map(|v| [v[0], ny(v[1]), v[2]].map(normalmap::quantize16)).collect())
+            }
+            Depth::Float => NormalData::F32(n.iter().flat_map(|v| [v[0], ny(v[1]), v[2]]).collect()),
+        };
+        NormalImage { width: w, height: h, channels: 3, data }
+    };
+    let depth = if s.sixteen_bit { Depth::Bits16 } else { Depth::Bits8 };
+    let png = normalmap::png_bytes(&img(depth, false), PngSettings::default()).map_err(Error::usage)?;
+    let mut files = Vec::new();
+    if let Some(p) = &s.map_out {
+        let format = normalmap::OutputFormat::from_path(p)?;
+        let d = if format == normalmap::OutputFormat::Exr { Depth::Float } else { depth };
+        let bytes =
+            normalmap::image_bytes(&img(d, s.convention == Convention::Directx), format, PngSettings::default())
+                .map_err(|e| Error::output(p, e))?;
+        files.push((p.clone(), bytes));
+    }
+    let hits: Vec<f32> = texels.iter().filter(|x| x.hits > 0).map(|x| x.height).collect();
+    let range = (!hits.is_empty()).then(|| {
+        [hits.iter().cloned().fold(f32::INFINITY, f32::min), hits.iter().cloned().fold(f32::NEG_INFINITY, f32::max)]
+    });
+    if let Some(p) = &s.height_out {
+        let [lo, hi] = range.unwrap_or([0.0, 0.0]);
+        let span = if hi > lo { hi - lo } else { 1.0 };
+        let v: Vec<u16> = texels
+            .iter()
+            .map(|x| {
+                let d = if x.hits > 0 { x.height } else { 0.0 };
+                (((d - lo) / span).clamp(0.0, 1.0) * 65535.0).round() as u16
+            })
+            .collect();
+        let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(w as u32, h as u32, v).expect("sized");
+        files.push((p.clone(), png_of(image::DynamicImage::ImageLuma16(img), p)?));
+    }
+    if let Some(p) = &s.miss_mask {
+        let v: Vec<u8> = texels
+            .iter()
+            .map(|x| if x.samples == 0 { 0 } else { ((x.missed as f32 / x.samples as f32) * 255.0).round() as u8 })
+            .collect();
+        let img = image::GrayImage::from_raw(w as u32, h as u32, v).expect("sized");
+        files.push((p.clone(), png_of(image::DynamicImage::ImageLuma8(img), p)?));
+    }
+    Ok((png, files, range))
+}
+
+fn png_of(img: image::DynamicImage, path: &std::path::Path) -> Result<Vec<u8>> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| Error::output(path, e))?;
+    Ok(out.into_inner())
+}
+
+impl TransferReport {
+    pub fn text(&self) -> String {
+        let c = &self.counts;
+        let tris: usize = self.high.iter().map(|h| h.triangles).sum();
+        let mut s = format!(
+            "  from {} HIGH file(s), {tris} triangles, onto {} LOW triangles: {}x{}, {} sample(s) per texel, rays {:.4} out / {:.4} in\n",
+            self.high.len(),
+            self.low_triangles,
+            self.width,
+            self.height,
+            self.samples_per_texel,
+            self.ray_front,
+            self.ray_back
+        );
+        s += &format!(
+            "  texels: {} covered, {} at island borders, {} padded, {} left flat\n",
+            c.covered, c.extended, c.padded, c.uncovered
+        );
+        s += &format!(
+            "  rays: {}, {} missed HIGH ({} texels; flat there{})\n",
+            c.rays,
+            c.missed_rays,
+            c.texels_with_misses,
+            if c.missed_rays > 0 { ", see --miss-mask" } else { "" }
+        );
+        if c.overlapping_samples > 0 || c.zero_uv_triangles > 0 {
+            s += &format!(
+                "  UVs: {} samples in overlapping triangles (first triangle baked), {} triangles without UV area\n",
+                c.overlapping_samples, c.zero_uv_triangles
+            );
+        }
+        if c.clamped_below > 0 || c.degenerate_frames > 0 {
+            s += &format!(
+                "  {} hit normals facing away from LOW (clamped), {} degenerate LOW frames (flat)\n",
+                c.clamped_below, c.degenerate_frames
+            );
+        }
+        if let Some([lo, hi]) = self.height_range {
+            s += &format!("  HIGH lies {lo:.5} to {hi:.5} from LOW along the rays (scene units)\n");
+        }
+        s
+    }
+}
