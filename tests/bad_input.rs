@@ -441,19 +441,28 @@ fn truncated_png_is_refused_everywhere() {
 /// Error lines are plain words: no Rust debug text such as `Some(Jpeg)`.
 #[test]
 fn unsupported_image_formats_are_named_in_words() {
-    let d = case("jpeg_height");
+    let d = case("gif_height");
+    // A GIF's header: enough for its format to be recognised; bumpbake reads no GIF.
+    let gif = d.join("h.gif");
+    std::fs::write(&gif, b"GIF89a\x01\x00\x01\x00\x00\x00\x00;").unwrap();
+    // A JPEG's start (SOI, a JFIF APP0 segment) and its end, with no image between.
     let jpg = d.join("h.jpg");
-    // A JPEG's start: SOI, then a JFIF APP0 segment; enough for its format to be recognised.
     let mut bytes = vec![0xFF, 0xD8, 0xFF, 0xE0, 0x00, 0x10];
     bytes.extend_from_slice(b"JFIF\0\x01\x01\0\0\x01\0\x01\0\0");
     bytes.extend_from_slice(&[0xFF, 0xD9]);
     std::fs::write(&jpg, &bytes).unwrap();
     let out = d.join("n.png");
-    for args in [vec!["normalmap", s(&jpg), "-o", s(&out)], vec!["validate", s(&jpg)]] {
-        let o = run(&args);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains("JPG images cannot be read") && err.contains("convert it to PNG"), "{args:?}: {err}");
-        assert!(!err.contains("Some(") && !err.contains("Jpeg"), "{args:?}: debug text in {err}");
+    for (img, words) in [(&gif, "a GIF image, which bumpbake does not decode"), (&jpg, "cannot decode as JPEG")] {
+        for args in [vec!["normalmap", s(img), "-o", s(&out)], vec!["validate", s(img)]] {
+            let o = run(&args);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+            assert!(err.contains(words), "{args:?}: {err}");
+            assert!(
+                !err.contains("Some(") && !err.contains("Jpeg") && !err.contains('"'),
+                "{args:?}: debug text in {err}"
+            );
+            assert!(!out.exists());
+        }
     }
 }

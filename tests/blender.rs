@@ -124,7 +124,6 @@ fn every_command_runs_on_the_blender_exports() {
 /// written uncompressed (MikkTSpace on the decoded mesh) or refused with a line naming the
 /// extension; never exit 0 with tangents bumpbake did not make or check.
 #[test]
-#[ignore = "needs Draco decoding or an explicit refusal of KHR_draco_mesh_compression in tangents"]
 fn draco_export_gets_tangents_or_a_refusal() {
     let v = validated_dir("blender_draco");
     for overwrite in [false, true] {

@@ -152,8 +152,8 @@ pub fn flat_png() -> Vec<u8> {
 
 /// Puts `png` in place of the image material `m`'s normal texture shows (its name kept).
 pub fn replace_normal_image(scene: &mut Scene, m: usize, png: &[u8]) {
-    let Some(t) = scene.json["materials"][m].pointer("/normalTexture/index").and_then(|t| t.as_u64()) else { return };
-    let Some(img) = scene.texture_image(t as usize) else { return };
+    let mats = scene.materials();
+    let Some(img) = mats.get(m).and_then(|m| m.texture(Slot::Normal)).and_then(|t| t.image()) else { return };
     let name = scene.json["images"][img].get("name").and_then(|n| n.as_str()).map(String::from);
     let new = scene.push_image(png, "image/png", name.as_deref());
     let images = crate::scene::array_mut(&mut scene.json, "images");

@@ -130,14 +130,15 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
 /// A texture needs UV coordinates to be placed: a primitive without the set its material's
 /// textures read is refused, not written as a file renderers cannot draw.
 fn check_uv_sets(scene: &Scene, job: &BakeJob) -> Result<()> {
+    let mats = scene.materials();
     for r in scene.primitives() {
-        let Some(material) = scene.material_of(r) else { continue };
-        let attrs = scene.prim_json(r).get("attributes").and_then(|a| a.as_object());
-        let has = |k: u32| attrs.is_some_and(|a| a.contains_key(&format!("TEXCOORD_{k}")));
-        if let Some((tex, set)) = crate::scene::texcoord::missing_sets(material, has).into_iter().next() {
-            let name = material.get("name").and_then(|n| n.as_str()).unwrap_or("(unnamed)");
-            let what =
-                if set == 0 { "no UV coordinates".to_string() } else { format!("no UV set {set} (TEXCOORD_{set})") };
+        if let Some((m, t)) = mats.missing_uv_sets(scene, r).into_iter().next() {
+            let set = t.tex_coord;
+            let what = if set == 0 {
+                "no UV coordinates (TEXCOORD_0)".to_string()
+            } else {
+                format!("no UV set {set} (TEXCOORD_{set})")
+            };
             let fix = if job.mesh.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
                 "give the mesh UVs (vt lines in the OBJ) and bake again"
             } else {
@@ -146,8 +147,11 @@ fn check_uv_sets(scene: &Scene, job: &BakeJob) -> Result<()> {
             return Err(Error::input(
                 &job.mesh,
                 format!(
-                    "mesh {} primitive {} has {what}, so material '{name}' cannot place its {tex} on it; {fix}",
-                    r.mesh, r.primitive
+                    "mesh {} primitive {} has {what}, so {} cannot place its {} on it; {fix}",
+                    r.mesh,
+                    r.primitive,
+                    m.label(),
+                    t.name()
                 ),
             ));
         }

@@ -277,8 +277,9 @@ pub fn evaluate(
     let nrm: Vec<[f32; 3]> = get("NORMAL")?.to_f32();
     let tan: Vec<[f32; 4]> = get("TANGENT")?.to_f32();
     let uv: Vec<[f32; 2]> = get("TEXCOORD_0")?.to_f32();
-    let tex = scene.json.pointer("/materials/0/normalTexture/index").and_then(|t| t.as_u64());
-    let img = tex.and_then(|t| scene.texture_image(t as usize)).ok_or_else(|| scene.err("no normal texture"))?;
+    let mats = scene.materials();
+    let normal = mats.get(0).and_then(|m| m.texture(crate::scene::Slot::Normal));
+    let img = normal.and_then(|t| t.image()).ok_or_else(|| scene.err("no normal texture"))?;
     let bytes = scene.image_bytes(img)?;
     let map = image::load_from_memory(&bytes).map_err(|e| Error::input(out, e.to_string()))?;
     let (w, h) = (map.width() as usize, map.height() as usize);

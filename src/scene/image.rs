@@ -160,7 +160,8 @@ fn not_decoded(kind: Kind) -> String {
 /// One line of plain words for a decoder's error. The `image` crate's own messages name formats
 /// by their Rust names (`Jpeg`, `Some(Png)`), so only the underlying cause is kept.
 fn describe(kind: Kind, e: ImageError) -> String {
-    let one_line = |s: String| s.split_whitespace().collect::<Vec<_>>().join(" ");
+    // Some decoders quote their message (a string's debug form); the quotes are not words.
+    let one_line = |s: String| s.split_whitespace().collect::<Vec<_>>().join(" ").trim_matches('"').to_string();
     let name = kind.name();
     match e {
         ImageError::Decoding(d) => match std::error::Error::source(&d) {

@@ -176,6 +176,11 @@ pub struct TextureUse {
 }
 
 impl TextureUse {
+    /// The texture's property name in the material (`normalTexture`, `baseColorTexture`, ...).
+    pub fn name(&self) -> &str {
+        self.pointer.rsplit('/').next().unwrap_or(&self.pointer)
+    }
+
     /// The image to read for this texture: the plain `source`, else the first extension's.
     pub fn image(&self) -> Option<usize> {
         self.images.first().map(|i| i.image)
@@ -325,6 +330,23 @@ impl Materials {
             sets.extend(self.list[m].tangent_needs.iter().map(|n| n.tex_coord));
         }
         sets
+    }
+
+    /// Every texture of the materials the primitive can show, with its material.
+    pub fn textures_of(&self, scene: &Scene, r: PrimRef) -> Vec<(&MaterialInfo, &TextureUse)> {
+        let mut out = Vec::new();
+        for m in self.of_primitive(scene, r) {
+            out.extend(self.list[m].textures.iter().map(|t| (&self.list[m], t)));
+        }
+        out
+    }
+
+    /// The textures of [`Self::textures_of`] that read a UV set the primitive does not have:
+    /// nothing can place them.
+    pub fn missing_uv_sets(&self, scene: &Scene, r: PrimRef) -> Vec<(&MaterialInfo, &TextureUse)> {
+        let attrs = scene.prim_json(r).get("attributes").and_then(|a| a.as_object());
+        let has = |k: u32| attrs.is_some_and(|a| a.contains_key(&format!("TEXCOORD_{k}")));
+        self.textures_of(scene, r).into_iter().filter(|(_, t)| !has(t.tex_coord)).collect()
     }
 
     /// Each image read as a normal map (normal or clearcoat normal texture), with the materials

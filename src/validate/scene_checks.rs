@@ -19,12 +19,12 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.mesh = Some(r.mesh);
         s.primitive = Some(r.primitive);
         let pj = scene.prim_json(r);
-        check_texcoords(scene, r, &mut s);
+        check_texcoords(scene, &mats, r, &mut s);
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
         // A compressed primitive whose normal map needs frames is a warning: its frames go
         // unchecked, and `--strict` must not pass them silently.
         let (code, why) = if let Some(why) = crate::scene::draco::why_unreadable(scene, r) {
-            let code = if scene.normal_texcoord(r).is_some() {
+            let code = if mats.tangent_need(scene, r).is_some() {
                 Code::PRIMITIVE_COMPRESSED
             } else {
                 Code::PRIMITIVE_NOT_CHECKED
@@ -94,25 +94,28 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     Ok(done)
 }
 
-/// Each texture of the primitive's material must find the UV set it reads.
-fn check_texcoords(scene: &Scene, r: PrimRef, s: &mut Subject) {
-    use crate::scene::texcoord;
-    let Some(material) = scene.material_of(r) else { return };
-    let mut textures = 0;
-    texcoord::texture_infos(material, &mut |_, _| textures += 1);
+/// Each texture of the primitive's materials (its own and its variants') must find the UV set it
+/// reads.
+fn check_texcoords(scene: &Scene, mats: &Materials, r: PrimRef, s: &mut Subject) {
+    let textures = mats.textures_of(scene, r).len();
     if textures == 0 {
         return;
     }
-    let attrs = scene.prim_json(r).get("attributes").and_then(|a| a.as_object());
-    let missing = texcoord::missing_sets(material, |k| attrs.is_some_and(|a| a.contains_key(&format!("TEXCOORD_{k}"))));
+    let missing = mats.missing_uv_sets(scene, r);
     let finding = (!missing.is_empty()).then(|| {
-        let list: Vec<String> = missing.iter().map(|(tex, set)| format!("{tex} reads TEXCOORD_{set}")).collect();
+        let mut list: Vec<String> = Vec::new();
+        for (m, t) in &missing {
+            let line = format!("{} {} reads TEXCOORD_{}", m.label(), t.name(), t.tex_coord);
+            if !list.contains(&line) {
+                list.push(line);
+            }
+        }
         Finding::new(
             Code::TEXCOORD_MISSING,
             missing.len(),
             textures,
             "textures",
-            format!("the primitive lacks the UV sets its material's textures read: {}", list.join(", ")),
+            format!("the primitive lacks the UV sets its materials' textures read: {}", list.join(", ")),
         )
     });
     s.check(Code::TEXCOORD_MISSING, finding);
