@@ -42,18 +42,6 @@ fn half_tilted_png() -> Vec<u8> {
     out.into_inner()
 }
 
-fn texture(g: &mut Gltf, png: &[u8]) -> usize {
-    use base64::Engine as _;
-    let uri = format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png));
-    let o = g.json.as_object_mut().unwrap();
-    let images = o.entry("images").or_insert(json!([])).as_array_mut().unwrap();
-    images.push(json!({ "uri": uri }));
-    let img = images.len() - 1;
-    let textures = g.json.as_object_mut().unwrap().entry("textures").or_insert(json!([])).as_array_mut().unwrap();
-    textures.push(json!({ "source": img }));
-    textures.len() - 1
-}
-
 /// A rotation by pi/2 with the offset that keeps the unit square in place: `(u, v) -> (v, 1 - u)`.
 fn rotated() -> Value {
     json!({ "KHR_texture_transform": { "rotation": FRAC_PI_2, "offset": [0.0, 1.0] } })
@@ -98,7 +86,7 @@ fn tangents_follow_a_rotated_normal_texture() {
     let mirrored = json!({ "KHR_texture_transform": { "scale": [-1.0, 1.0], "offset": [1.0, 0.0] } });
     for (name, transform, want) in [("rotated", rotated(), ROTATED_T), ("mirrored", mirrored, [-1.0, 0.0, 0.0, -1.0])] {
         let mut g = Gltf::new();
-        let t = texture(&mut g, &tiny_png());
+        let t = g.png_texture(&tiny_png());
         let mut prim = quad(&mut g, false, None);
         prim["material"] = json!(g.material(json!({ "normalTexture": { "index": t, "extensions": transform } })));
         g.mesh(prim);
@@ -123,7 +111,7 @@ fn validate_passes_the_rotated_frame_and_flags_the_plain_one() {
     let d = validated_dir("materials_rotated_validate");
     let make = |name: &str, t: [f32; 4]| {
         let mut g = Gltf::new();
-        let tex = texture(&mut g, &tiny_png());
+        let tex = g.png_texture(&tiny_png());
         let mut prim = quad(&mut g, false, Some(t));
         prim["material"] = json!(g.material(json!({ "normalTexture": { "index": tex, "extensions": rotated() } })));
         g.mesh(prim);
@@ -155,7 +143,7 @@ fn preview_samples_and_frames_through_the_transform() {
     // The reference: the transform applied to the stored UVs by hand, no extension.
     let make = |name: &str, transform: bool, pre_rotated: bool| {
         let mut g = Gltf::new();
-        let tex = texture(&mut g, &png);
+        let tex = g.png_texture(&png);
         let mut prim = quad(&mut g, false, None);
         if pre_rotated {
             let (_, _, uv, _) = grid(2);
@@ -201,7 +189,7 @@ fn preview_samples_and_frames_through_the_transform() {
 fn a_clearcoat_normal_texture_alone_gets_tangents_from_its_uv_set() {
     let (d, scratch) = (validated_dir("materials_clearcoat"), scratch_dir("materials_clearcoat"));
     let mut g = Gltf::new();
-    let tex = texture(&mut g, &tiny_png());
+    let tex = g.png_texture(&tiny_png());
     let mut prim = quad(&mut g, true, None);
     let cc = json!({ "clearcoatFactor": 1.0, "clearcoatNormalTexture": { "index": tex, "texCoord": 1 } });
     prim["material"] = json!(g.material(json!({ "extensions": { "KHR_materials_clearcoat": cc } })));
@@ -255,7 +243,7 @@ fn anisotropy_alone_keeps_and_gets_tangents() {
 /// reading TEXCOORD_1.
 fn variants(dir: &Path, name: &str, t: Option<[f32; 4]>) -> PathBuf {
     let mut g = Gltf::new();
-    let tex = texture(&mut g, &tiny_png());
+    let tex = g.png_texture(&tiny_png());
     let mut prim = quad(&mut g, true, t);
     let plain = g.material(json!({ "name": "plain" }));
     let bumpy = g.material(json!({ "name": "bumpy", "normalTexture": { "index": tex, "texCoord": 1 } }));

@@ -17,19 +17,6 @@ fn png_bytes(img: &image::RgbImage) -> Vec<u8> {
     out.into_inner()
 }
 
-/// Adds `png` as an image + texture (data URI, default sampler); returns the texture index.
-fn add_texture(g: &mut Gltf, png: &[u8]) -> usize {
-    use base64::Engine as _;
-    let uri = format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png));
-    let o = g.json.as_object_mut().unwrap();
-    let images = o.entry("images").or_insert(json!([])).as_array_mut().unwrap();
-    images.push(json!({ "uri": uri }));
-    let img = images.len() - 1;
-    let textures = g.json.as_object_mut().unwrap().entry("textures").or_insert(json!([])).as_array_mut().unwrap();
-    textures.push(json!({ "source": img }));
-    textures.len() - 1
-}
-
 /// Encodes a unit tangent-space normal as the conventions say: 8 bits, rounded.
 fn encode(n: [f64; 3]) -> [u8; 3] {
     n.map(|c| ((c * 0.5 + 0.5) * 255.0).round().clamp(0.0, 255.0) as u8)
@@ -77,7 +64,7 @@ fn write_mesh(path: &Path, mesh: Mesh16, tangents: Option<Vec<[f32; 4]>>, normal
     let mut prim = json!({ "attributes": attrs, "indices": a_i });
     let material = match normal_png {
         Some(png) => {
-            let t = add_texture(&mut g, png);
+            let t = g.png_texture(png);
             json!({ "normalTexture": { "index": t }, "pbrMetallicRoughness": { "baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0 } })
         }
         None => json!({ "pbrMetallicRoughness": { "baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0 } }),
@@ -440,7 +427,7 @@ fn bad_input_exits_2_with_one_line_naming_the_file() {
     let (p, n, uv, idx) = grid(1);
     let (a_p, a_n, a_uv, a_i) =
         (g.floats(&p, Some(34962)), g.floats(&n, Some(34962)), g.floats(&uv, Some(34962)), g.indices(&idx));
-    let t = add_texture(&mut g, b"not a png");
+    let t = g.png_texture(b"not a png");
     let m = g.material(json!({ "normalTexture": { "index": t } }));
     g.mesh(
         json!({ "attributes": { "POSITION": a_p, "NORMAL": a_n, "TEXCOORD_0": a_uv }, "indices": a_i, "material": m }),

@@ -51,11 +51,6 @@ pub fn make_assets(dir: &Path, n: usize) -> Result<Vec<PathBuf>> {
     Ok(paths)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[v.len() / 2]
-}
-
 fn run_ok(cmd: &mut Command) -> Result<()> {
     let out = cmd.output().map_err(|e| Error::usage(format!("bench batch: cannot run bumpbake: {e}")))?;
     if !out.status.success() {
@@ -91,6 +86,6 @@ pub fn run(exe: &Path, dir: &Path, n: usize, jobs: usize, runs: usize) -> Result
         )?;
         par.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    let (one_by_one_ms, batch_ms) = (median(seq), median(par));
+    let (one_by_one_ms, batch_ms) = (super::median(&mut seq), super::median(&mut par));
     Ok(BatchBench { assets: n, jobs, runs: runs.max(1), one_by_one_ms, batch_ms, ratio: batch_ms / one_by_one_ms })
 }

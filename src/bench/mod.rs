@@ -9,3 +9,16 @@ pub mod surfaces;
 pub mod tangents;
 pub mod tangents_plot;
 pub mod transfer;
+
+/// The median of `v` (sorted in place), the mean of the middle two for an even count; 0 when empty.
+pub(crate) fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}

@@ -384,18 +384,6 @@ pub struct Report {
     pub rows: Vec<Row>,
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        0.0
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Times `engine` on `case`: returns the last output and the run times in milliseconds.
 pub fn time_engine(case: &Case, engine: Engine, runs: usize) -> (Vec<Option<[f32; 4]>>, Vec<f64>) {
     let mesh = case.mesh();
@@ -439,7 +427,7 @@ pub fn run(opts: &Options, mut progress: impl FnMut(&Row)) -> crate::error::Resu
         if with_ref {
             let (out, mut times) = time_engine(&case, Engine::Bevy, opts.runs);
             let min = times.iter().copied().fold(f64::INFINITY, f64::min);
-            reference = Some((out, median(&mut times), min));
+            reference = Some((out, super::median(&mut times), min));
         }
         for &e in &opts.engines {
             let (out, med, min_ms) = if e == Engine::Bevy {
@@ -448,7 +436,7 @@ pub fn run(opts: &Options, mut progress: impl FnMut(&Row)) -> crate::error::Resu
             } else {
                 let (out, mut times) = time_engine(&case, e, opts.runs);
                 let min = times.iter().copied().fold(f64::INFINITY, f64::min);
-                (out, median(&mut times), min)
+                (out, super::median(&mut times), min)
             };
             let (vs_ref, identical) = match &reference {
                 Some((r, _, _)) => {

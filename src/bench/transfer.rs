@@ -395,18 +395,6 @@ pub struct Report {
     pub scaling: Vec<Row>,
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        0.0
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Runs `exe bake low --from high` `runs` times and measures the last output.
 #[allow(clippy::too_many_arguments)]
 fn time_one(
@@ -459,12 +447,12 @@ fn time_one(
         size,
         samples,
         runs: times.len(),
-        median_s: median(&mut times),
+        median_s: super::median(&mut times),
         min_s,
         max_s,
-        read_high_ms: median(&mut a),
-        bvh_ms: median(&mut b),
-        rays_ms: median(&mut c),
+        read_high_ms: super::median(&mut a),
+        bvh_ms: super::median(&mut b),
+        rays_ms: super::median(&mut c),
         peak_mb: peak as f64 * 1024.0 / 1e6,
         error,
     })

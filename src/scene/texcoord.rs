@@ -21,14 +21,7 @@ pub fn texture_infos(v: &Value, f: &mut dyn FnMut(&str, &Value)) {
 
 /// [`texture_infos`] for changing them.
 pub fn texture_infos_mut(v: &mut Value, f: &mut dyn FnMut(&mut Value)) {
-    if let Some(o) = v.as_object_mut() {
-        for (k, child) in o.iter_mut() {
-            if k.ends_with("Texture") && child.get("index").is_some() {
-                f(child);
-            }
-            texture_infos_mut(child, f);
-        }
-    }
+    super::refs::texture_infos(v, f)
 }
 
 /// The set a texture info reads: `KHR_texture_transform`'s override, else `texCoord`, else 0.

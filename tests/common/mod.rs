@@ -197,7 +197,11 @@ impl Gltf {
 
     /// A 1x1 PNG as a data URI image + texture; returns the texture index.
     pub fn texture(&mut self) -> usize {
-        let png = tiny_png();
+        self.png_texture(&tiny_png())
+    }
+
+    /// `png` as a data URI image + texture (default sampler); returns the texture index.
+    pub fn png_texture(&mut self, png: &[u8]) -> usize {
         use base64::Engine as _;
         let uri = format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(png));
         let images = self.json.as_object_mut().unwrap().entry("images").or_insert(json!([]));
