@@ -215,7 +215,7 @@ impl TangentNeed {
 pub struct MaterialInfo {
     pub index: usize,
     pub name: Option<String>,
-    /// Every texture it reads, in [`SLOTS`] order, then any other `...Texture` objects.
+    /// Every texture it reads, in `SLOTS` order, then any other `...Texture` objects.
     pub textures: Vec<TextureUse>,
     /// Everything that needs tangents, most important first: normal, clearcoat normal, anisotropy.
     pub tangent_needs: Vec<TangentNeed>,

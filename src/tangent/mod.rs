@@ -1,7 +1,7 @@
 //! Tangent frames: MikkTSpace generation ([`mikk`]), the fallback for corners the reference
 //! leaves undefined ([`fallback`]), and applying both to a primitive, splitting vertices whose
 //! corners got different frames and merging identical ones ([`primitive_with_tangents`]), with
-//! TANGENT deltas for the morph targets that move the surface ([`morph`]).
+//! TANGENT deltas for the morph targets that move the surface (`morph.rs`).
 //! [`apply`] decides which primitives of a scene need tangents.
 
 pub mod apply;
