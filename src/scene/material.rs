@@ -430,18 +430,16 @@ impl Scene {
 
     fn texture_use(&self, slot: Slot, pointer: &str, colour: ColourSpace, info: &Value) -> Option<TextureUse> {
         let texture = info.get("index").and_then(as_index)?;
-        let over = info.pointer("/extensions/KHR_texture_transform/texCoord").and_then(|v| v.as_u64());
-        let tex_coord = over.or_else(|| info.get("texCoord").and_then(|v| v.as_u64())).unwrap_or(0) as u32;
+        let tex_coord = super::texcoord::effective_set(info);
         let tj = self.array("textures").get(texture);
-        let mut images = Vec::new();
-        if let Some(i) = tj.and_then(|t| t.get("source")).and_then(as_index) {
-            images.push(ImageSource { image: i, via: "source" });
-        }
-        for ext in super::refs::IMAGE_SOURCE_EXTENSIONS {
-            if let Some(i) = tj.and_then(|t| t.pointer(&format!("/extensions/{ext}/source"))).and_then(as_index) {
-                images.push(ImageSource { image: i, via: ext });
-            }
-        }
+        // The plain source first (the core formats), then the extensions' in the order a client
+        // prefers them.
+        let mut images: Vec<ImageSource> = self
+            .texture_images(texture)
+            .into_iter()
+            .map(|t| ImageSource { image: t.image, via: t.extension.unwrap_or("source") })
+            .collect();
+        images.sort_by_key(|i| i.via != "source");
         let scale_key = if slot == Slot::Occlusion { "strength" } else { "scale" };
         Some(TextureUse {
             slot,

@@ -5,7 +5,7 @@
 //! coordinates: node transforms are not applied, the frames bumpbake writes are mesh-local too.
 
 use crate::error::{Error, Result};
-use crate::scene::{smooth_normals, PrimRef, Primitive, ReadOptions, Scene};
+use crate::scene::{smooth_normals, PrimRef, Primitive, ReadOptions, Scene, Slot};
 use crate::tangent::apply::to_triangle_list;
 use glam::{DVec3, Vec3A};
 use std::path::Path;
@@ -52,8 +52,9 @@ pub fn low(scene: &Scene, prims: &[PrimRef]) -> Result<Low> {
     let mut out = Low::default();
     let mut parts: Vec<(Primitive, u32)> = Vec::new();
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    let mats = scene.materials();
     for &r in prims {
-        let set = scene.normal_texcoord(r).unwrap_or(0);
+        let set = mats.default_of(scene, r).and_then(|m| m.texture(Slot::Normal)).map_or(0, |t| t.tex_coord);
         let p = scene.primitive(r)?;
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
         for need in [&format!("TEXCOORD_{set}"), "POSITION", "NORMAL", "TANGENT"] {
