@@ -181,11 +181,11 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
         Ok(bytes) => {
             info.bytes = bytes.len();
             // Only the header is read: a file claiming a huge size costs nothing here.
-            let kind = crate::scene::image::Kind::sniff(&bytes);
-            if kind != crate::scene::image::Kind::Unknown {
+            let kind = crate::format::image::Kind::sniff(&bytes);
+            if kind != crate::format::image::Kind::Unknown {
                 info.format = Some(kind.name().to_ascii_lowercase());
             }
-            match crate::scene::image::header(&bytes) {
+            match crate::format::image::header(&bytes) {
                 Ok(h) => {
                     info.width = Some(h.width);
                     info.height = Some(h.height);

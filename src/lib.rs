@@ -17,6 +17,7 @@ pub mod bake;
 pub mod batch;
 pub mod bench;
 pub mod error;
+pub mod format;
 pub mod inspect;
 pub mod normalmap;
 pub mod output;

@@ -207,11 +207,11 @@ fn truncated_png() -> Vec<u8> {
 #[test]
 fn hostile_png_headers_parse_without_allocating() {
     assert_eq!(crc32(b"IEND"), 0xAE42_6082, "the CRC helper is right");
-    let e = bumpbake::scene::image::dimensions(&png_claiming(200_000, 200_000)).unwrap_err();
+    let e = bumpbake::format::image::dimensions(&png_claiming(200_000, 200_000)).unwrap_err();
     assert!(e.contains("200000x200000"), "{e}");
-    assert!(bumpbake::scene::image::decode(&png_claiming(200_000, 200_000)).is_err());
-    assert!(bumpbake::scene::image::decode(&truncated_png()).is_err());
-    assert_eq!(bumpbake::scene::image::dimensions(&tiny_png()).unwrap(), (1, 1));
+    assert!(bumpbake::format::image::decode(&png_claiming(200_000, 200_000)).is_err());
+    assert!(bumpbake::format::image::decode(&truncated_png()).is_err());
+    assert_eq!(bumpbake::format::image::dimensions(&tiny_png()).unwrap(), (1, 1));
 }
 
 /// `tangents` carries images along byte for byte and never decodes them: a truncated PNG and

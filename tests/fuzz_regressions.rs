@@ -1,7 +1,8 @@
 //! Every input a fuzz target ever crashed on (`fuzz/regressions/TARGET/`), replayed through the
 //! same steps as the target, so a fixed crash stays fixed without a nightly toolchain.
 
-use bumpbake::scene::{ReadOptions, Scene, WriteOptions};
+use bumpbake::format::WriteOptions;
+use bumpbake::scene::{ReadOptions, Scene};
 use bumpbake::tangent::apply::{apply, ApplyOptions};
 use std::path::{Path, PathBuf};
 
@@ -19,7 +20,7 @@ fn exercise(path: &str, data: &[u8]) {
     }
     if apply(&mut scene, &ApplyOptions { all: true, ..Default::default() }).is_ok() {
         let _ =
-            bumpbake::scene::write(&scene, Path::new("/nonexistent-bumpbake-fuzz/out.glb"), &WriteOptions::default());
+            bumpbake::format::write(&scene, Path::new("/nonexistent-bumpbake-fuzz/out.glb"), &WriteOptions::default());
     }
 }
 
@@ -40,6 +41,6 @@ fn obj_read_regressions() {
 #[test]
 fn image_decode_regressions() {
     for f in inputs("image_decode") {
-        let _ = bumpbake::scene::image::decode(&std::fs::read(&f).unwrap());
+        let _ = bumpbake::format::image::decode(&std::fs::read(&f).unwrap());
     }
 }

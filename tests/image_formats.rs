@@ -1,5 +1,5 @@
 //! Every command that reads an image reads PNG, JPEG and WebP alike (one reader in
-//! `scene::image`), names formats it does not decode, and refuses broken files in plain words.
+//! `format::image`), names formats it does not decode, and refuses broken files in plain words.
 
 mod common;
 use common::*;

@@ -213,7 +213,7 @@ fn mirrored_halves_of_the_khronos_model_render_alike() {
     p.set_attr("TANGENT", bumpbake::scene::Stream::from_f32("VEC4", &t));
     scene.set_primitive(P0, &p);
     let broken = dir.join("no_w.glb");
-    let (outs, _) = bumpbake::scene::write(&scene, &broken, &Default::default()).unwrap();
+    let (outs, _) = bumpbake::format::write(&scene, &broken, &Default::default()).unwrap();
     outs.commit().unwrap();
     let bdir = dir.join("broken");
     std::fs::create_dir_all(&bdir).unwrap();
@@ -345,7 +345,7 @@ fn pipeline_error_is_small_and_catches_flipped_green_and_w() {
     p.set_attr("TANGENT", bumpbake::scene::Stream::from_f32("VEC4", &t));
     scene.set_primitive(P0, &p);
     let flipped = scratch.join("w.glb");
-    let (outs, _) = bumpbake::scene::write(&scene, &flipped, &Default::default()).unwrap();
+    let (outs, _) = bumpbake::format::write(&scene, &flipped, &Default::default()).unwrap();
     outs.commit().unwrap();
     let w = pipeline_error(&hi, &flipped, &scratch.join("diff_w.png"));
     assert!(w["normal_angle_deg"]["mean"].as_f64().unwrap() > 4.0, "flipped w not caught: {w}");

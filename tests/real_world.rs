@@ -6,7 +6,7 @@
 //! `BUMPBAKE_CORPUS`, which `.ci/run` sets; under `CI=true` a missing corpus fails the test.
 
 mod common;
-use bumpbake::scene::dequant::{transformed_uvs, unit_normals};
+use bumpbake::format::dequant::{transformed_uvs, unit_normals};
 use bumpbake::tangent::mikk::{generate, Engine};
 use bumpbake::tangent::TriMesh;
 use common::*;
@@ -20,7 +20,7 @@ fn assert_mikktspace(out: &Path) -> usize {
     let mut compared = 0;
     for r in scene.primitives() {
         let Some(set) = scene.normal_texcoord(r) else { continue };
-        let p = bumpbake::tangent::apply::to_triangle_list(scene.primitive(r).unwrap());
+        let p = bumpbake::scene::to_triangle_list(scene.primitive(r).unwrap());
         let t = p.attr("TANGENT").unwrap_or_else(|| panic!("{}: {r:?} has a normal texture and no TANGENT", s(out)));
         assert_eq!(t.format.component_type, bumpbake::scene::accessor::FLOAT, "tangents written as floats");
         let t = t.to_f32::<4>();
@@ -121,7 +121,7 @@ fn spoil_tangents(input: &Path, out: &Path, turn_deg: f32, flip: f32) {
         p.set_attr("TANGENT", bumpbake::scene::Stream::from_f32("VEC4", &changed));
         scene.set_primitive(r, &p);
     }
-    let (files, _) = bumpbake::scene::write(&scene, out, &Default::default()).unwrap();
+    let (files, _) = bumpbake::format::write(&scene, out, &Default::default()).unwrap();
     files.commit().unwrap();
 }
 

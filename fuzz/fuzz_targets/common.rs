@@ -2,7 +2,8 @@
 // primitive decoded, tangents generated on all of them, the result encoded in memory) and check
 // that every tangent written obeys the conventions.
 
-use bumpbake::scene::{ReadOptions, Scene, WriteOptions};
+use bumpbake::format::WriteOptions;
+use bumpbake::scene::{ReadOptions, Scene};
 use bumpbake::tangent::apply::{apply, ApplyOptions};
 use std::path::Path;
 
@@ -35,5 +36,5 @@ pub fn exercise(path: &str, data: &[u8]) {
             }
         }
     }
-    let _ = bumpbake::scene::write(&scene, Path::new("/nonexistent-bumpbake-fuzz/out.glb"), &WriteOptions::default());
+    let _ = bumpbake::format::write(&scene, Path::new("/nonexistent-bumpbake-fuzz/out.glb"), &WriteOptions::default());
 }

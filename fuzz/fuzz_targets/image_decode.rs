@@ -1,6 +1,6 @@
 #![no_main]
 //! Image bytes through the guarded decoder every command that reads pixels uses.
-use bumpbake::scene::image as guarded;
+use bumpbake::format::image as guarded;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

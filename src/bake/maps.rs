@@ -88,8 +88,8 @@ pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -
         None => detected_dx && confident,
     };
     let check = ConventionCheck { detected: detected.describe().into(), confidence, converted: is_dx };
-    let kind = crate::scene::image::Kind::sniff(&bytes);
-    let core = matches!(kind, crate::scene::image::Kind::Png | crate::scene::image::Kind::Jpeg);
+    let kind = crate::format::image::Kind::sniff(&bytes);
+    let core = matches!(kind, crate::format::image::Kind::Png | crate::format::image::Kind::Jpeg);
     if !is_dx && core {
         // PNG and JPEG are glTF's own image formats: embedded as given, byte for byte.
         return Ok((bytes, check));
@@ -137,7 +137,7 @@ fn encode(img: image::DynamicImage) -> std::result::Result<Vec<u8>, String> {
 /// Gives material `m` the normal map in `png` (PNG or JPEG bytes, as a new image and texture)
 /// from UV set 0, sampled like its base colour texture.
 pub fn attach(scene: &mut Scene, m: usize, png: &[u8], name: &str) {
-    let jpeg = crate::scene::image::Kind::sniff(png) == crate::scene::image::Kind::Jpeg;
+    let jpeg = crate::format::image::Kind::sniff(png) == crate::format::image::Kind::Jpeg;
     let img = scene.push_image(png, if jpeg { "image/jpeg" } else { "image/png" }, Some(name));
     let sampler = scene.materials().get(m).and_then(|m| m.texture(Slot::BaseColor)).and_then(|t| t.sampler);
     let t = scene.push_texture(img, sampler);

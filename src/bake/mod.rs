@@ -6,9 +6,10 @@ pub mod leave_out;
 pub mod maps;
 
 use crate::error::{Error, Result};
+use crate::format::{self, WriteOptions, WriteStats};
 use crate::normalmap::Convention;
 use crate::report::Timings;
-use crate::scene::{self, ReadOptions, Scene, WriteOptions, WriteStats};
+use crate::scene::{ReadOptions, Scene};
 use crate::tangent::apply::{apply, ApplyOptions, PrimReport};
 use leave_out::Removal;
 use maps::{ConventionCheck, HeightSettings};
@@ -104,7 +105,7 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
     } else {
         t.time("leave-out", || leave_out::leave_out(&mut scene, job.bitangents))?
     };
-    let (mut files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
+    let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &deps));
     }
@@ -194,7 +195,7 @@ fn attach_maps(
         None => None,
     };
     let mats = scene.materials();
-    let has_normal_texture = |m: usize| mats.get(m).and_then(|i| i.texture(scene::Slot::Normal)).is_some();
+    let has_normal_texture = |m: usize| mats.get(m).and_then(|i| i.texture(crate::scene::Slot::Normal)).is_some();
     let wants_bump = |m: usize| scene.height_maps.iter().any(|h| h.material == m) || has_normal_texture(m);
     let targets: Vec<usize> = match (chosen, &job.map) {
         (Some(m), _) => vec![m],

@@ -93,7 +93,7 @@ impl Case {
             label,
         };
         for r in scene.primitives() {
-            let p = crate::tangent::apply::to_triangle_list(scene.primitive(r)?);
+            let p = crate::scene::to_triangle_list(scene.primitive(r)?);
             let Some(uv) = p.attr("TEXCOORD_0") else { continue };
             let pos = p.positions();
             let nrm = match p.attr("NORMAL") {

@@ -3,8 +3,9 @@
 use bumpbake::bake::maps::HeightSettings;
 use bumpbake::bake::{run as run_job, BakeJob, BakeReport, MapSource};
 use bumpbake::batch;
+use bumpbake::format::WriteOptions;
 use bumpbake::normalmap::{Channel, Convention, Filter};
-use bumpbake::scene::{ReadOptions, WriteOptions};
+use bumpbake::scene::ReadOptions;
 use bumpbake::transfer::Settings;
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};

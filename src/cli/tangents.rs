@@ -1,7 +1,8 @@
 //! `bumpbake tangents IN... -o OUT | --out-dir DIR`.
 
 use bumpbake::batch;
-use bumpbake::scene::{NormalMode, ReadOptions, WriteOptions};
+use bumpbake::format::WriteOptions;
+use bumpbake::scene::{NormalMode, ReadOptions};
 use bumpbake::tangent::apply::ApplyOptions;
 use bumpbake::tangent::command::{run as run_job, TangentsJob, TangentsReport};
 use bumpbake::tangent::Options;

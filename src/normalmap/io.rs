@@ -17,16 +17,16 @@ fn one_line(e: impl std::fmt::Display) -> String {
     e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-/// Opens and decodes an image (any format [`crate::scene::image`] reads), refusing it first if its
+/// Opens and decodes an image (any format [`crate::format::image`] reads), refusing it first if its
 /// header claims more than `max_pixels`.
 pub fn open_image(path: &Path, max_pixels: u64) -> Result<DynamicImage> {
-    crate::scene::image::read_file(path, max_pixels)
+    crate::format::image::read_file(path, max_pixels)
 }
 
 /// Reads a height map: PNG (8/16-bit gray, gray+alpha, RGB, RGBA, palette), JPEG, WebP, TIFF, or
 /// EXR.
 pub fn load_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<HeightPlane> {
-    if crate::scene::image::file_is_png(path) {
+    if crate::format::image::file_is_png(path) {
         if let Some(plane) = load_png_height(path, channel, max_pixels)? {
             return Ok(plane);
         }
@@ -138,7 +138,7 @@ fn check_png_complete(path: &Path) -> Result<()> {
 }
 
 fn check_size(path: &Path, w: u32, h: u32, max_pixels: u64) -> Result<()> {
-    crate::scene::image::check_size_within(w, h, &crate::scene::image::Limits::file(max_pixels))
+    crate::format::image::check_size_within(w, h, &crate::format::image::Limits::file(max_pixels))
         .map_err(|m| Error::input(path, m))
 }
 

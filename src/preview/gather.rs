@@ -10,9 +10,9 @@
 use super::texture::{Sampler, Texture};
 use crate::error::Result;
 use crate::scene::material::{MaterialInfo, TextureUse};
+use crate::scene::nodes::{instances, Instance};
 use crate::scene::{flat_normals, Materials, PrimRef, Scene, Slot, UvTransform};
-use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
-use serde_json::Value;
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -112,7 +112,7 @@ impl Prepared {
         };
         let mut draws = Vec::new();
         let mut prim_cache: HashMap<PrimRef, Option<Local>> = HashMap::new();
-        for (mesh, world) in instances(scene) {
+        for Instance { mesh, world, .. } in instances(scene) {
             let n = scene
                 .json
                 .pointer(&format!("/meshes/{mesh}/primitives"))
@@ -319,77 +319,6 @@ impl Cx<'_> {
         };
         Ok(Some(TexRef { texture, sampler, texcoord, transform: t.transform }))
     }
-}
-
-/// Every (mesh, world matrix) the scene shows.
-fn instances(scene: &Scene) -> Vec<(usize, Mat4)> {
-    let j = &scene.json;
-    let nodes = j.get("nodes").and_then(|n| n.as_array()).map(|n| n.as_slice()).unwrap_or(&[]);
-    let roots: Vec<usize> = if let Some(sc) = j.get("scenes").and_then(|s| s.as_array()).filter(|s| !s.is_empty()) {
-        let si = j.get("scene").and_then(|s| s.as_u64()).unwrap_or(0) as usize;
-        let sc = sc.get(si).or(sc.first());
-        sc.and_then(|s| s.get("nodes"))
-            .and_then(|n| n.as_array())
-            .map(|a| a.iter().filter_map(|x| x.as_u64()).map(|x| x as usize).collect())
-            .unwrap_or_default()
-    } else if !nodes.is_empty() {
-        let mut child = vec![false; nodes.len()];
-        for n in nodes {
-            for c in n.get("children").and_then(|c| c.as_array()).into_iter().flatten().filter_map(|c| c.as_u64()) {
-                if let Some(x) = child.get_mut(c as usize) {
-                    *x = true;
-                }
-            }
-        }
-        (0..nodes.len()).filter(|&i| !child[i]).collect()
-    } else {
-        let meshes = j.get("meshes").and_then(|m| m.as_array()).map(|m| m.len()).unwrap_or(0);
-        return (0..meshes).map(|m| (m, Mat4::IDENTITY)).collect();
-    };
-    let mut out = Vec::new();
-    let mut stack: Vec<(usize, Mat4, usize)> = roots.into_iter().rev().map(|r| (r, Mat4::IDENTITY, 0)).collect();
-    while let Some((n, parent, depth)) = stack.pop() {
-        // glTF node graphs are trees; a cyclic or absurdly deep file must not hang the preview.
-        let Some(node) = nodes.get(n) else { continue };
-        if depth > 64 || out.len() > 1_000_000 {
-            continue;
-        }
-        let world = parent * local_matrix(node);
-        if let Some(m) = node.get("mesh").and_then(|m| m.as_u64()) {
-            out.push((m as usize, world));
-        }
-        let children: Vec<usize> = node
-            .get("children")
-            .and_then(|c| c.as_array())
-            .into_iter()
-            .flatten()
-            .filter_map(|c| c.as_u64())
-            .map(|c| c as usize)
-            .collect();
-        for c in children.into_iter().rev() {
-            stack.push((c, world, depth + 1));
-        }
-    }
-    out
-}
-
-fn floats(v: Option<&Value>, n: usize) -> Option<Vec<f32>> {
-    let a = v?.as_array()?;
-    let f: Vec<f32> = a.iter().map(|x| x.as_f64().map(|x| x as f32)).collect::<Option<_>>()?;
-    (f.len() == n && f.iter().all(|x| x.is_finite())).then_some(f)
-}
-
-fn local_matrix(node: &Value) -> Mat4 {
-    if let Some(m) = floats(node.get("matrix"), 16) {
-        return Mat4::from_cols_slice(&m);
-    }
-    let t = floats(node.get("translation"), 3).map(|v| Vec3::from_slice(&v)).unwrap_or(Vec3::ZERO);
-    let r = floats(node.get("rotation"), 4)
-        .map(|v| Quat::from_slice(&v).normalize())
-        .filter(|q| q.is_finite())
-        .unwrap_or(Quat::IDENTITY);
-    let s = floats(node.get("scale"), 3).map(|v| Vec3::from_slice(&v)).unwrap_or(Vec3::ONE);
-    Mat4::from_scale_rotation_translation(s, r, t)
 }
 
 fn place(l: &Local, world: Mat4, material: usize, source: PrimRef) -> Draw {

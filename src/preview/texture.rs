@@ -93,11 +93,11 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 }
 
 impl Texture {
-    /// Decodes image bytes (any format [`crate::scene::image`] reads, under its texture limits).
+    /// Decodes image bytes (any format [`crate::format::image`] reads, under its texture limits).
     /// Colour textures are sRGB-encoded in glTF and are linearised here; data textures (normal
     /// maps) must keep their encoded values, so `srgb` is false.
     pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
-        let img = crate::scene::image::decode(bytes)?;
+        let img = crate::format::image::decode(bytes)?;
         let rgba = img.to_rgba32f();
         let (w, h) = (rgba.width() as usize, rgba.height() as usize);
         if w == 0 || h == 0 {

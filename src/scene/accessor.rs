@@ -1,4 +1,9 @@
-//! Accessor layouts and the raw, tightly packed vertex streams the model keeps.
+//! Accessor layouts and the raw, tightly packed vertex streams the model keeps, and how an
+//! accessor's bytes (strided views, sparse substitution) become one.
+
+use super::{as_index, Scene};
+use crate::error::Result;
+use serde_json::Value;
 
 /// glTF component types.
 pub const BYTE: u32 = 5120;
@@ -275,6 +280,96 @@ impl Stream {
         let s = self.format.elem_size();
         &self.data[i * s..(i + 1) * s]
     }
+}
+
+/// The bytes of a buffer view, already checked to be in range.
+fn view_bytes(s: &Scene, view: usize) -> Result<(&[u8], Option<usize>)> {
+    let v = s.array("bufferViews").get(view).ok_or_else(|| s.err(format!("bufferView {view} does not exist")))?;
+    let b = v.get("buffer").and_then(as_index).unwrap_or(0);
+    let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let stride = v.get("byteStride").and_then(|o| o.as_u64()).map(|x| x as usize);
+    Ok((&s.buffers[b][off..off + len], stride))
+}
+
+pub fn read_accessor(s: &Scene, idx: usize) -> Result<Stream> {
+    let a = s.array("accessors").get(idx).ok_or_else(|| s.err(format!("accessor {idx} does not exist")))?;
+    let ct = a.get("componentType").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
+    let ty = a.get("type").and_then(|t| t.as_str()).unwrap_or("");
+    let count =
+        a.get("count").and_then(|c| c.as_u64()).ok_or_else(|| s.err(format!("accessor {idx} has no count")))? as usize;
+    let format = Format {
+        component_type: ct,
+        ty: ty.to_string(),
+        normalized: a.get("normalized").and_then(|n| n.as_bool()).unwrap_or(false),
+    };
+    let (Some(_), Some(_)) = (component_size(ct), component_count(ty)) else {
+        return Err(s.err(format!("accessor {idx} has an unknown componentType {ct} or type '{ty}'")));
+    };
+    let es = format.elem_size();
+    let total = count
+        .checked_mul(es)
+        .filter(|&t| t <= 1 << 31)
+        .ok_or_else(|| s.err(format!("accessor {idx}: count {count} is absurd")))?;
+    let mut data = vec![0u8; 0];
+    match a.get("bufferView").and_then(as_index) {
+        Some(view) => {
+            let (bytes, stride) = view_bytes(s, view)?;
+            let off = a.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+            let stride = stride.unwrap_or(es).max(es);
+            // Matrices of 1- and 2-byte components pad each column to 4 bytes.
+            let col_pad = matches!(ty, "MAT2" | "MAT3" | "MAT4") && component_size(ct).unwrap_or(4) < 4;
+            if col_pad {
+                return Err(s.err(format!("accessor {idx}: padded matrix layouts are not supported")));
+            }
+            let need = if count == 0 { 0 } else { off + stride * (count - 1) + es };
+            if need > bytes.len() {
+                return Err(s.err(format!(
+                    "accessor {idx} needs {need} bytes of bufferView {view}, which has {}",
+                    bytes.len()
+                )));
+            }
+            data.reserve(total);
+            for i in 0..count {
+                let at = off + i * stride;
+                data.extend_from_slice(&bytes[at..at + es]);
+            }
+        }
+        None => data.resize(total, 0),
+    }
+    if let Some(sp) = a.get("sparse") {
+        apply_sparse(s, idx, sp, es, count, &mut data)?;
+    }
+    Ok(Stream { format, data, template: Some(a.clone()) })
+}
+
+fn apply_sparse(s: &Scene, idx: usize, sp: &Value, es: usize, count: usize, data: &mut [u8]) -> Result<()> {
+    let n = sp.get("count").and_then(|c| c.as_u64()).unwrap_or(0) as usize;
+    let bad = |m: &str| s.err(format!("accessor {idx}: sparse {m}"));
+    let iv = sp.pointer("/indices/bufferView").and_then(as_index).ok_or_else(|| bad("indices without bufferView"))?;
+    let ioff = sp.pointer("/indices/byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let ict = sp.pointer("/indices/componentType").and_then(|o| o.as_u64()).unwrap_or(0) as u32;
+    let ics = component_size(ict).ok_or_else(|| bad("indices have an unknown componentType"))?;
+    let vv = sp.pointer("/values/bufferView").and_then(as_index).ok_or_else(|| bad("values without bufferView"))?;
+    let voff = sp.pointer("/values/byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let (ib, _) = view_bytes(s, iv)?;
+    let (vb, _) = view_bytes(s, vv)?;
+    if ioff + n * ics > ib.len() || voff + n * es > vb.len() {
+        return Err(bad("data runs past its bufferView"));
+    }
+    for k in 0..n {
+        let at = ioff + k * ics;
+        let i = match ics {
+            1 => ib[at] as usize,
+            2 => u16::from_le_bytes([ib[at], ib[at + 1]]) as usize,
+            _ => u32::from_le_bytes([ib[at], ib[at + 1], ib[at + 2], ib[at + 3]]) as usize,
+        };
+        if i >= count {
+            return Err(bad(&format!("index {i} is past the accessor's count {count}")));
+        }
+        data[i * es..(i + 1) * es].copy_from_slice(&vb[voff + k * es..voff + (k + 1) * es]);
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -97,7 +97,7 @@ impl Scene {
 }
 
 /// Where one buffer view's bytes come from, and where they land in the packed buffer.
-pub(super) struct Piece {
+pub(crate) struct Piece {
     pub buffer: usize,
     pub range: Range<usize>,
     pub at: usize,
@@ -105,7 +105,7 @@ pub(super) struct Piece {
 
 /// Lays the buffer views out back to back in buffer 0, each at a multiple of 4, in order, and
 /// points them there. None, and nothing changed, when a view runs past its buffer.
-pub(super) fn pack_views(json: &mut Value, buffers: &[Vec<u8>]) -> Option<Vec<Piece>> {
+pub(crate) fn pack_views(json: &mut Value, buffers: &[Vec<u8>]) -> Option<Vec<Piece>> {
     let Some(views) = json.get_mut("bufferViews").and_then(|v| v.as_array_mut()) else { return Some(Vec::new()) };
     let mut pieces = Vec::with_capacity(views.len());
     let mut end = 0usize;
@@ -125,7 +125,7 @@ pub(super) fn pack_views(json: &mut Value, buffers: &[Vec<u8>]) -> Option<Vec<Pi
     Some(pieces)
 }
 
-pub(super) fn set_offset(v: &mut Value, at: usize) {
+pub(crate) fn set_offset(v: &mut Value, at: usize) {
     if at == 0 {
         if let Some(o) = v.as_object_mut() {
             o.remove("byteOffset");
@@ -137,8 +137,9 @@ pub(super) fn set_offset(v: &mut Value, at: usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ReadOptions, WriteOptions};
     use super::*;
+    use crate::format::{write, WriteOptions};
+    use crate::scene::ReadOptions;
     use base64::Engine as _;
     use std::path::Path;
 
@@ -239,7 +240,7 @@ mod tests {
             s.put_primitive(P, p);
             for ext in ["glb", "gltf"] {
                 let out = dir.path().join(format!("o.{ext}"));
-                let (files, stats) = super::super::write(&s, &out, &WriteOptions::default()).unwrap();
+                let (files, stats) = write(&s, &out, &WriteOptions::default()).unwrap();
                 files.commit().unwrap();
                 let bin = std::fs::read(dir.path().join("o.bin")).unwrap_or_default();
                 written.push((ext, std::fs::read(&out).unwrap(), bin, format!("{stats:?}")));

@@ -7,29 +7,22 @@
 //! longer referenced. OBJ input is converted into the same model on reading.
 
 pub mod accessor;
-mod compact;
-pub mod dequant;
-pub mod draco;
-mod gltf_read;
-mod gltf_write;
-pub mod image;
+pub(crate) mod compact;
 pub mod material;
-mod meshopt;
-mod obj;
+pub mod nodes;
+pub mod normals;
 pub mod refs;
 pub mod texcoord;
-pub mod uri;
 pub mod weld;
 
 pub use accessor::{Format, Stream};
-pub use gltf_write::{write, WriteOptions, WriteStats};
 pub use material::{Materials, PrimNeed, Slot, TangentNeed, UvTransform};
-pub use obj::{flat_normals, smooth_normals};
+pub use normals::{flat_normals, smooth_normals};
 
 use crate::error::{Error, Result};
 use accessor::*;
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Options that change how inputs are read.
 #[derive(Debug, Clone, Default)]
@@ -120,6 +113,24 @@ impl Primitive {
     }
 }
 
+/// Strips and fans become lists, so every later stage sees three indices per triangle.
+pub fn to_triangle_list(mut p: Primitive) -> Primitive {
+    let i = &p.indices;
+    let list: Vec<u32> = match p.mode {
+        5 => (2..i.len())
+            .flat_map(|k| if k % 2 == 0 { [i[k - 2], i[k - 1], i[k]] } else { [i[k - 1], i[k - 2], i[k]] })
+            .collect(),
+        6 => (2..i.len()).flat_map(|k| [i[0], i[k - 1], i[k]]).collect(),
+        _ => {
+            let n = i.len() / 3 * 3;
+            i[..n].to_vec()
+        }
+    };
+    p.indices = list;
+    p.mode = 4;
+    p
+}
+
 /// Where a primitive sits in the document.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 pub struct PrimRef {
@@ -128,74 +139,6 @@ pub struct PrimRef {
 }
 
 impl Scene {
-    /// Reads an `.obj`, `.gltf` or `.glb` file (GLB is recognised by its magic, not its name).
-    pub fn read(path: &Path, opts: &ReadOptions) -> Result<Scene> {
-        let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-        if ext != "obj" && bytes.starts_with(b"glTF") {
-            return gltf_read::read_glb_owned(path, bytes, opts);
-        }
-        Scene::read_bytes(path, &bytes, opts)
-    }
-
-    /// Reads a scene from bytes already in memory. `path` names the file in messages, decides the
-    /// format by its extension (GLB is recognised by its magic) and is the folder relative URIs
-    /// resolve against.
-    pub fn read_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-        if ext == "obj" {
-            obj::read(path, bytes, opts)
-        } else if bytes.starts_with(b"glTF") || ext == "glb" {
-            gltf_read::read_glb(path, bytes, opts)
-        } else if ext == "gltf" || bytes.first().map(|b| *b == b'{').unwrap_or(false) {
-            gltf_read::read_gltf(path, bytes, opts)
-        } else {
-            Err(Error::input(path, "unknown mesh format (expected .obj, .gltf or .glb)"))
-        }
-    }
-
-    /// Every file the output depends on: the source, external buffers, MTL files, images and
-    /// height maps, for Make/Ninja depfiles.
-    pub fn dependencies(&self) -> Vec<PathBuf> {
-        let mut out = vec![self.source.clone()];
-        out.extend(self.deps.iter().cloned());
-        for img in self.array("images") {
-            if let Some(u) = img.get("uri").and_then(|u| u.as_str()) {
-                if let Ok(uri::Target::File(p)) = uri::resolve(u, &self.base_dir, &self.source, self.allow_outside) {
-                    out.push(p);
-                }
-            }
-        }
-        out.extend(self.height_maps.iter().map(|h| h.path.clone()));
-        let mut seen = std::collections::HashSet::new();
-        out.retain(|p| seen.insert(p.clone()));
-        out
-    }
-
-    /// The encoded bytes of image `i` (from its URI, data URI or buffer view).
-    pub fn image_bytes(&self, i: usize) -> Result<Vec<u8>> {
-        let img = self.array("images").get(i).ok_or_else(|| self.err(format!("image {i} does not exist")))?;
-        if let Some(u) = img.get("uri").and_then(|u| u.as_str()) {
-            return uri::read(u, &self.base_dir, &self.source, self.allow_outside);
-        }
-        let v = img
-            .get("bufferView")
-            .and_then(as_index)
-            .ok_or_else(|| self.err(format!("image {i} has neither uri nor bufferView")))?;
-        let view = self
-            .array("bufferViews")
-            .get(v)
-            .ok_or_else(|| self.err(format!("image {i}: bufferView {v} does not exist")))?;
-        let b = view.get("buffer").and_then(as_index).unwrap_or(0);
-        let off = view.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-        let len = view.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-        self.buffers
-            .get(b)
-            .and_then(|buf| buf.get(off..off.saturating_add(len)))
-            .map(|s| s.to_vec())
-            .ok_or_else(|| self.err(format!("image {i}: bufferView {v} runs past its buffer")))
-    }
-
     /// Adds encoded image bytes (kept in the buffer) as a new image; returns its index.
     pub fn push_image(&mut self, bytes: &[u8], mime: &str, name: Option<&str>) -> usize {
         let s = Stream {
@@ -226,7 +169,7 @@ impl Scene {
         Error::input(&self.source, msg)
     }
 
-    fn array(&self, key: &str) -> &[Value] {
+    pub(crate) fn array(&self, key: &str) -> &[Value] {
         self.json.get(key).and_then(|v| v.as_array()).map(|v| v.as_slice()).unwrap_or(&[])
     }
 
@@ -264,14 +207,6 @@ impl Scene {
     /// `KHR_texture_transform` of the texture that needs them), if any.
     pub fn normal_uv_transform(&self, r: PrimRef) -> Option<UvTransform> {
         self.materials().tangent_need(self, r)?.need.transform
-    }
-
-    /// Reads a primitive's streams, indices and morph targets.
-    pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
-        if let Some(why) = draco::why_unreadable(self, r) {
-            return Err(self.err(why));
-        }
-        self.declared_primitive(r)
     }
 
     /// The primitive as its accessors declare it, for listing: the same as
@@ -350,7 +285,7 @@ impl Scene {
 
     /// Reads an accessor into a dense stream (sparse substitution applied).
     pub fn accessor(&self, idx: usize) -> Result<Stream> {
-        gltf_read::read_accessor(self, idx)
+        accessor::read_accessor(self, idx)
     }
 
     /// Puts a primitive back: its streams become new accessors, and the primitive's JSON points

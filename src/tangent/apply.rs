@@ -93,7 +93,7 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
         match needs_tangents(scene, &mats, r, opts.all) {
             Err(why) => reports.push(report("skipped", Some(why), None)),
             Ok(uvs) => {
-                let p = to_triangle_list(scene.primitive(r)?);
+                let p = crate::scene::to_triangle_list(scene.primitive(r)?);
                 let why = match p.attr("TANGENT") {
                     Some(t) if !opts.overwrite => match invalid_tangents(t) {
                         0 => {
@@ -151,22 +151,4 @@ pub fn invalid_tangents(t: &crate::scene::Stream) -> usize {
             !(len.is_finite() && (len - 1.0).abs() <= tolerance && (v[3] == 1.0 || v[3] == -1.0))
         })
         .count()
-}
-
-/// Strips and fans become lists, so every later stage sees three indices per triangle.
-pub fn to_triangle_list(mut p: Primitive) -> Primitive {
-    let i = &p.indices;
-    let list: Vec<u32> = match p.mode {
-        5 => (2..i.len())
-            .flat_map(|k| if k % 2 == 0 { [i[k - 2], i[k - 1], i[k]] } else { [i[k - 1], i[k - 2], i[k]] })
-            .collect(),
-        6 => (2..i.len()).flat_map(|k| [i[0], i[k - 1], i[k]]).collect(),
-        _ => {
-            let n = i.len() / 3 * 3;
-            i[..n].to_vec()
-        }
-    };
-    p.indices = list;
-    p.mode = 4;
-    p
 }

@@ -2,8 +2,9 @@
 
 use super::apply::{apply, ApplyOptions, PrimReport};
 use crate::error::Result;
+use crate::format::{self, WriteOptions, WriteStats};
 use crate::report::Timings;
-use crate::scene::{self, ReadOptions, Scene, WriteOptions, WriteStats};
+use crate::scene::{ReadOptions, Scene};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, Default)]
@@ -41,7 +42,7 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     crate::report::mem_mark("read");
     let prims = t.time("tangents", || apply(&mut scene, &job.apply))?;
     crate::report::mem_mark("tangents");
-    let (mut files, written) = t.time("encode", || scene::write(&scene, &job.output, &job.write))?;
+    let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;
     crate::report::mem_mark("encode");
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &scene.dependencies()));

@@ -12,8 +12,9 @@ pub mod frames;
 pub mod mikk;
 mod morph;
 
+use crate::format::dequant;
 use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
-use crate::scene::{dequant, flat_normals, Primitive, UvTransform};
+use crate::scene::{flat_normals, Primitive, UvTransform};
 use fallback::FallbackCounts;
 use glam::Vec3;
 

@@ -5,8 +5,8 @@
 //! coordinates: node transforms are not applied, the frames bumpbake writes are mesh-local too.
 
 use crate::error::{Error, Result};
+use crate::scene::to_triangle_list;
 use crate::scene::{smooth_normals, PrimRef, Primitive, ReadOptions, Scene, Slot};
-use crate::tangent::apply::to_triangle_list;
 use glam::{DVec3, Vec3A};
 use std::path::Path;
 

@@ -290,7 +290,7 @@ pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
         let scene = Scene::read(path, &opts.read)?;
         FileReport { path: path.to_path_buf(), kind: "mesh", subjects: validate_scene(&scene, opts)? }
     } else {
-        use crate::scene::image::{self as img, Kind};
+        use crate::format::image::{self as img, Kind};
         let limits = img::Limits::file(crate::normalmap::DEFAULT_MAX_PIXELS);
         let img = img::decode_within(&bytes, &limits).map_err(|e| match Kind::sniff(&bytes) {
             Kind::Unknown => Error::input(

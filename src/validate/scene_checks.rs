@@ -4,8 +4,9 @@
 use super::frames::{self, Explained, PrimData, Quant};
 use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
 use crate::error::Result;
-use crate::scene::{dequant, image, Materials, PrimRef, Scene};
-use crate::tangent::apply::to_triangle_list;
+use crate::format::{dequant, image};
+use crate::scene::to_triangle_list;
+use crate::scene::{Materials, PrimRef, Scene};
 use rayon::prelude::*;
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -23,7 +24,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
         // A compressed primitive whose normal map needs frames is a warning: its frames go
         // unchecked, and `--strict` must not pass them silently.
-        let (code, why) = if let Some(why) = crate::scene::draco::why_unreadable(scene, r) {
+        let (code, why) = if let Some(why) = crate::format::draco::why_unreadable(scene, r) {
             let code = if mats.tangent_need(scene, r).is_some() {
                 Code::PRIMITIVE_COMPRESSED
             } else {

@@ -6,8 +6,8 @@
 //! The decoders are meshoptimizer's own (through the `meshopt` crate), which its author documents
 //! as safe on untrusted input; everything they are handed is bounds-checked here first.
 
-use super::as_index;
 use crate::error::{Error, Result};
+use crate::scene::as_index;
 use serde_json::Value;
 use std::path::Path;
 

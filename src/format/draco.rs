@@ -2,7 +2,7 @@
 //! A Draco primitive's accessors hold no data of their own, so reading one is an error that says
 //! how to get an uncompressed file; primitives nothing reads pass through the writer untouched.
 
-use super::{PrimRef, Scene};
+use crate::scene::{PrimRef, Scene};
 
 pub const EXT: &str = "KHR_draco_mesh_compression";
 

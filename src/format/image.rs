@@ -345,17 +345,17 @@ pub struct TextureImage {
     pub extension: Option<&'static str>,
 }
 
-impl super::Scene {
+impl crate::scene::Scene {
     /// Every image texture `texture` can show: the extensions' sources first (a client that
     /// supports one shows it), then the core `source` (the fallback). Each image once.
     pub fn texture_images(&self, texture: usize) -> Vec<TextureImage> {
         let Some(t) = self.json.pointer(&format!("/textures/{texture}")) else { return Vec::new() };
         let mut out: Vec<TextureImage> = Vec::new();
-        let from_ext = super::refs::IMAGE_SOURCE_EXTENSIONS.iter().filter_map(|&ext| {
-            let i = t.pointer(&format!("/extensions/{ext}/source")).and_then(super::as_index)?;
+        let from_ext = crate::scene::refs::IMAGE_SOURCE_EXTENSIONS.iter().filter_map(|&ext| {
+            let i = t.pointer(&format!("/extensions/{ext}/source")).and_then(crate::scene::as_index)?;
             Some(TextureImage { image: i, extension: Some(ext) })
         });
-        let core = t.get("source").and_then(super::as_index).map(|i| TextureImage { image: i, extension: None });
+        let core = t.get("source").and_then(crate::scene::as_index).map(|i| TextureImage { image: i, extension: None });
         for ti in from_ext.chain(core) {
             if !out.iter().any(|o| o.image == ti.image) {
                 out.push(ti);
@@ -385,7 +385,7 @@ impl super::Scene {
     }
 }
 
-/// What [`super::Scene::texture_image_to_decode`] found.
+/// What [`crate::scene::Scene::texture_image_to_decode`] found.
 #[derive(Debug, Default)]
 pub struct TextureChoice {
     /// The image to decode and its encoded bytes.

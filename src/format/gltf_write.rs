@@ -4,11 +4,12 @@
 //! into one buffer, and renumbers the references. Anything it cannot prove unreferenced (data an
 //! unknown extension might point at) is kept.
 
-use super::compact::{pack_views, set_offset};
-use super::refs::{accessor_refs, drop_unreferenced, unknown_data_refs, view_refs, Dangling};
-use super::{uri, Scene};
+use super::uri;
 use crate::error::{Error, Result};
 use crate::output::Outputs;
+use crate::scene::compact::{pack_views, set_offset};
+use crate::scene::refs::{accessor_refs, drop_unreferenced, unknown_data_refs, view_refs, Dangling};
+use crate::scene::Scene;
 use base64::Engine as _;
 use serde_json::{json, Value};
 use std::borrow::Cow;
@@ -164,7 +165,7 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
         let mut v = json!({ "buffer": 0, "byteLength": bytes.len() });
         set_offset(&mut v, at);
         bin.push(Cow::Owned(bytes));
-        let views = super::array_mut(&mut json, "bufferViews");
+        let views = crate::scene::array_mut(&mut json, "bufferViews");
         views.push(v);
         json["images"][img]["bufferView"] = json!(views_len(&json) - 1);
     }

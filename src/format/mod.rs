@@ -1,0 +1,99 @@
+//! Every file format bumpbake reads or writes, in a room of its own below the stages.
+//!
+//! Each reader hands over the same [`Scene`] (glTF JSON + buffers, OBJ converted on reading) and
+//! the image reader the same decoded image, so no stage learns where a mesh or a texture came
+//! from. Compression (meshopt) is decoded right after parsing, as gltfpack's `parsegltf.cpp` does.
+
+pub mod dequant;
+pub mod draco;
+mod gltf_read;
+mod gltf_write;
+pub mod image;
+mod meshopt;
+mod obj;
+pub mod raw;
+pub mod uri;
+
+pub use gltf_write::{write, WriteOptions, WriteStats};
+
+use crate::error::{Error, Result};
+use crate::scene::{as_index, PrimRef, Primitive, ReadOptions, Scene};
+use std::path::{Path, PathBuf};
+
+impl Scene {
+    /// Reads an `.obj`, `.gltf` or `.glb` file (GLB is recognised by its magic, not its name).
+    pub fn read(path: &Path, opts: &ReadOptions) -> Result<Scene> {
+        let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        if ext != "obj" && bytes.starts_with(b"glTF") {
+            return gltf_read::read_glb_owned(path, bytes, opts);
+        }
+        Scene::read_bytes(path, &bytes, opts)
+    }
+
+    /// Reads a scene from bytes already in memory. `path` names the file in messages, decides the
+    /// format by its extension (GLB is recognised by its magic) and is the folder relative URIs
+    /// resolve against.
+    pub fn read_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        if ext == "obj" {
+            obj::read(path, bytes, opts)
+        } else if bytes.starts_with(b"glTF") || ext == "glb" {
+            gltf_read::read_glb(path, bytes, opts)
+        } else if ext == "gltf" || bytes.first().map(|b| *b == b'{').unwrap_or(false) {
+            gltf_read::read_gltf(path, bytes, opts)
+        } else {
+            Err(Error::input(path, "unknown mesh format (expected .obj, .gltf or .glb)"))
+        }
+    }
+
+    /// Every file the output depends on: the source, external buffers, MTL files, images and
+    /// height maps, for Make/Ninja depfiles.
+    pub fn dependencies(&self) -> Vec<PathBuf> {
+        let mut out = vec![self.source.clone()];
+        out.extend(self.deps.iter().cloned());
+        for img in self.array("images") {
+            if let Some(u) = img.get("uri").and_then(|u| u.as_str()) {
+                if let Ok(uri::Target::File(p)) = uri::resolve(u, &self.base_dir, &self.source, self.allow_outside) {
+                    out.push(p);
+                }
+            }
+        }
+        out.extend(self.height_maps.iter().map(|h| h.path.clone()));
+        let mut seen = std::collections::HashSet::new();
+        out.retain(|p| seen.insert(p.clone()));
+        out
+    }
+
+    /// The encoded bytes of image `i` (from its URI, data URI or buffer view).
+    pub fn image_bytes(&self, i: usize) -> Result<Vec<u8>> {
+        let img = self.array("images").get(i).ok_or_else(|| self.err(format!("image {i} does not exist")))?;
+        if let Some(u) = img.get("uri").and_then(|u| u.as_str()) {
+            return uri::read(u, &self.base_dir, &self.source, self.allow_outside);
+        }
+        let v = img
+            .get("bufferView")
+            .and_then(as_index)
+            .ok_or_else(|| self.err(format!("image {i} has neither uri nor bufferView")))?;
+        let view = self
+            .array("bufferViews")
+            .get(v)
+            .ok_or_else(|| self.err(format!("image {i}: bufferView {v} does not exist")))?;
+        let b = view.get("buffer").and_then(as_index).unwrap_or(0);
+        let off = view.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+        let len = view.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+        self.buffers
+            .get(b)
+            .and_then(|buf| buf.get(off..off.saturating_add(len)))
+            .map(|s| s.to_vec())
+            .ok_or_else(|| self.err(format!("image {i}: bufferView {v} runs past its buffer")))
+    }
+
+    /// Reads a primitive's streams, indices and morph targets.
+    pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
+        if let Some(why) = draco::why_unreadable(self, r) {
+            return Err(self.err(why));
+        }
+        self.declared_primitive(r)
+    }
+}

@@ -1,0 +1,109 @@
+//! Vertex and face normals for meshes that come without them, robust to any triangle size.
+
+/// `v` multiplied by the power of two that brings its largest component into [1, 2). Exact in
+/// floating point, so directions computed from scaled edges are bit-identical to unscaled ones for
+/// ordinary meshes, while edges of 1e-20 (whose cross product would underflow to zero) or 1e30
+/// (which would overflow) still give their true direction.
+fn pow2_scaled(v: glam::Vec3) -> glam::Vec3 {
+    let m = v.abs().max_element();
+    if m == 0.0 || !m.is_finite() {
+        return v;
+    }
+    let e = m.log2().floor() as i32;
+    // Two steps: 2^149 alone does not fit in an f32.
+    let half = 2f32.powi(-(e / 2));
+    v * half * 2f32.powi(-(e - e / 2))
+}
+
+/// The unit normal of triangle `(a, b, c)` in counter-clockwise order, whatever its size, or
+/// `None` when it has no area (in float32).
+pub(crate) fn face_normal(a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> Option<glam::Vec3> {
+    let n = pow2_scaled(pow2_scaled(b - a).cross(pow2_scaled(c - a)));
+    let n = n.normalize_or_zero();
+    (n != glam::Vec3::ZERO && n.is_finite()).then_some(n)
+}
+
+/// Angle-weighted vertex normals over shared position indices. Returns per-corner normals and
+/// how many corners had none (only degenerate faces around them).
+pub fn smooth_normals(positions: &[f32], indices: &[u32]) -> (Vec<[f32; 3]>, usize) {
+    let p = |i: u32| glam::Vec3::from_slice(&positions[i as usize * 3..i as usize * 3 + 3]);
+    let mut acc = vec![glam::Vec3::ZERO; positions.len() / 3];
+    for t in indices.chunks_exact(3) {
+        let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+        let Some(n) = face_normal(a, b, c) else { continue };
+        for (k, (o, u, v)) in [(a, b, c), (b, c, a), (c, a, b)].into_iter().enumerate() {
+            let e1 = pow2_scaled(u - o).normalize_or_zero();
+            let e2 = pow2_scaled(v - o).normalize_or_zero();
+            let angle = e1.dot(e2).clamp(-1.0, 1.0).acos();
+            acc[t[k] as usize] += n * angle;
+        }
+    }
+    let mut fixed = 0;
+    let out = indices
+        .iter()
+        .map(|&i| {
+            let n = pow2_scaled(acc[i as usize]).normalize_or_zero();
+            if n == glam::Vec3::ZERO || !n.is_finite() {
+                fixed += 1;
+                [0.0, 0.0, 1.0]
+            } else {
+                n.to_array()
+            }
+        })
+        .collect();
+    (out, fixed)
+}
+
+/// One normal per face, from per-corner positions; faces without area get +Z.
+pub fn flat_normals(pos: &[[f32; 3]]) -> (Vec<[f32; 3]>, usize) {
+    let mut fixed = 0;
+    let mut out = Vec::with_capacity(pos.len());
+    for t in pos.chunks_exact(3) {
+        let n = match face_normal(glam::Vec3::from(t[0]), glam::Vec3::from(t[1]), glam::Vec3::from(t[2])) {
+            Some(n) => n.to_array(),
+            None => {
+                fixed += 3;
+                [0.0, 0.0, 1.0]
+            }
+        };
+        out.extend([n, n, n]);
+    }
+    (out, fixed)
+}
+
+pub(crate) fn unit_or_up(n: [f32; 3]) -> [f32; 3] {
+    let v = pow2_scaled(glam::Vec3::from(n)).normalize_or_zero();
+    if v == glam::Vec3::ZERO || !v.is_finite() {
+        [0.0, 0.0, 1.0]
+    } else {
+        v.to_array()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn face_normals_are_scale_free() {
+        for s in [1e-30f32, 1e-20, 1e-6, 1.0, 1e6, 1e30] {
+            let n = face_normal(Vec3::ZERO, Vec3::new(s, 0.0, 0.0), Vec3::new(0.0, s, 0.0));
+            let n = n.unwrap_or_else(|| panic!("scale {s}: no normal"));
+            assert!((n - Vec3::Z).length() < 1e-6, "scale {s}: {n:?}");
+        }
+        // Sliver: 1e-7 high over a unit base.
+        let n = face_normal(Vec3::ZERO, Vec3::X, Vec3::new(0.5, 1e-7, 0.0)).unwrap();
+        assert!((n - Vec3::Z).length() < 1e-6, "{n:?}");
+        assert_eq!(face_normal(Vec3::ZERO, Vec3::X, Vec3::X * 2.0), None);
+        assert_eq!(face_normal(Vec3::ONE, Vec3::ONE, Vec3::ONE), None);
+    }
+
+    #[test]
+    fn scaling_by_powers_of_two_is_exact() {
+        let v = Vec3::new(0.3, -1.7, 2.9);
+        let a = v.cross(Vec3::new(1.1, 0.2, -0.4)).normalize();
+        let b = pow2_scaled(pow2_scaled(v).cross(pow2_scaled(Vec3::new(1.1, 0.2, -0.4)))).normalize();
+        assert_eq!(a, b);
+    }
+}
