@@ -11,6 +11,8 @@ mod gltf_write;
 pub mod image;
 mod meshopt;
 mod obj;
+pub mod obj_parse;
+pub mod ply;
 pub mod raw;
 pub mod uri;
 
@@ -21,10 +23,15 @@ use crate::scene::{as_index, PrimRef, Primitive, ReadOptions, Scene};
 use std::path::{Path, PathBuf};
 
 impl Scene {
-    /// Reads an `.obj`, `.gltf` or `.glb` file (GLB is recognised by its magic, not its name).
+    /// Reads an `.obj`, `.ply`, `.gltf` or `.glb` file (GLB and PLY are also recognised by their
+    /// magic, not only their name).
     pub fn read(path: &Path, opts: &ReadOptions) -> Result<Scene> {
-        let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        if ext == "obj" {
+            // Streamed: the text is never held whole next to what is parsed from it.
+            return obj::read_file(path, opts);
+        }
+        let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
         if ext != "obj" && bytes.starts_with(b"glTF") {
             return gltf_read::read_glb_owned(path, bytes, opts);
         }
@@ -38,12 +45,14 @@ impl Scene {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
         if ext == "obj" {
             obj::read(path, bytes, opts)
+        } else if ext == "ply" || ply::is_ply(bytes) {
+            obj::ply_scene(path, ply::parse(path, bytes)?, opts)
         } else if bytes.starts_with(b"glTF") || ext == "glb" {
             gltf_read::read_glb(path, bytes, opts)
         } else if ext == "gltf" || bytes.first().map(|b| *b == b'{').unwrap_or(false) {
             gltf_read::read_gltf(path, bytes, opts)
         } else {
-            Err(Error::input(path, "unknown mesh format (expected .obj, .gltf or .glb)"))
+            Err(Error::input(path, "unknown mesh format (expected .obj, .ply, .gltf or .glb)"))
         }
     }
 

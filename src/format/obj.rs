@@ -1,73 +1,81 @@
-//! Reading Wavefront OBJ (+ MTL) into the glTF model.
+//! Reading Wavefront OBJ (+ MTL) into the glTF model: the geometry through the parallel parser
+//! in `obj_parse.rs`, the MTL libraries through `tobj` (the only part of it still used).
 //!
 //! UVs are kept as the OBJ stores them (v up) while tangents are generated, which is what makes the
 //! frames identical to the reference on OBJ input; the writer flips them to glTF's v down.
 
+use super::obj_parse::{self, ObjData, Statement, MISSING};
 use crate::error::{Error, Result};
 use crate::scene::normals::{flat_normals, smooth_normals, unit_or_up};
 use crate::scene::weld::weld;
 use crate::scene::{array_mut, HeightMapRef, NormalMode, PrimRef, ReadOptions, Scene, Stream};
 use serde_json::{json, Value};
-use std::cell::RefCell;
+use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::Path;
 
-pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
-    let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
-    let mtl_error: RefCell<Option<Error>> = RefCell::new(None);
-    let mtl_files: RefCell<Vec<std::path::PathBuf>> = RefCell::new(Vec::new());
-    let load = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
-    let (models, materials) = tobj::load_obj_buf(&mut BufReader::new(bytes), &load, |mtl: &Path| {
-        let name = mtl.to_string_lossy();
-        mtl_files.borrow_mut().push(base_dir.join(mtl));
-        match super::uri::read(&name, &base_dir, path, opts.allow_outside) {
-            Ok(b) => tobj::load_mtl_buf(&mut BufReader::new(b.as_slice())),
-            Err(e) => {
-                *mtl_error.borrow_mut() = Some(e);
-                Err(tobj::LoadError::OpenFileFailed)
-            }
-        }
-    })
-    .map_err(|e| Error::input(path, format!("malformed OBJ: {e}")))?;
-    if let Some(e) = mtl_error.into_inner() {
-        return Err(e);
-    }
-    let materials = materials.map_err(|e| Error::input(path, format!("malformed MTL: {e}")))?;
+/// Reads the OBJ file at `path`, streaming it through the parallel parser.
+pub fn read_file(path: &Path, opts: &ReadOptions) -> Result<Scene> {
+    let data = obj_parse::parse_file(path)?;
+    build_scene(path, data, opts)
+}
 
-    let mut scene = Scene {
-        json: json!({ "asset": { "version": "2.0", "generator": concat!("bumpbake ", env!("CARGO_PKG_VERSION")) } }),
-        buffers: Vec::new(),
-        source: path.to_path_buf(),
-        base_dir: base_dir.clone(),
-        allow_outside: opts.allow_outside,
-        uv_v_up: true,
-        notes: Vec::new(),
-        deps: mtl_files.into_inner(),
-        height_maps: Vec::new(),
-        ledger: Default::default(),
-        own_images: true,
-    };
+pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
+    let data = obj_parse::parse_bytes(path, bytes)?;
+    build_scene(path, data, opts)
+}
+
+/// Materials in order, their index by name, and the MTL files read.
+type Materials = (Vec<tobj::Material>, HashMap<String, usize>, Vec<std::path::PathBuf>);
+
+/// The MTL libraries an OBJ names, in order, merged as `tobj` merges them (a later definition
+/// of a name wins); also the files read, for depfiles.
+fn load_materials(path: &Path, base_dir: &Path, libs: &[String], opts: &ReadOptions) -> Result<Materials> {
+    let (mut materials, mut map, mut files, mut failed) = (Vec::new(), HashMap::new(), Vec::new(), None);
+    for name in libs {
+        files.push(base_dir.join(name));
+        let bytes = super::uri::read(name, base_dir, path, opts.allow_outside)?;
+        match tobj::load_mtl_buf(&mut BufReader::new(bytes.as_slice())) {
+            Ok((mut mats, names)) => {
+                let offset = materials.len();
+                materials.append(&mut mats);
+                map.extend(names.into_iter().map(|(k, v)| (k, v + offset)));
+            }
+            Err(e) => failed = Some(e),
+        }
+    }
+    match failed {
+        Some(e) if materials.is_empty() => Err(Error::input(path, format!("malformed MTL: {e}"))),
+        _ => Ok((materials, map, files)),
+    }
+}
+
+fn build_scene(path: &Path, data: ObjData, opts: &ReadOptions) -> Result<Scene> {
+    let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+    let (materials, material_ids, mtl_files) = load_materials(path, &base_dir, &data.mtllibs, opts)?;
+
+    let mut scene = empty_scene(path, opts, mtl_files);
     for (i, m) in materials.iter().enumerate() {
         add_material(&mut scene, i, m)?;
     }
 
     let mut nodes = Vec::new();
-    for model in &models {
-        if model.mesh.indices.is_empty() {
-            continue;
-        }
+    let mut remap = Remaps::new(&data);
+    for run in runs(&data, &material_ids) {
+        let name = &run.name;
         let mesh_idx = match scene.json.get("meshes").and_then(|m| m.as_array()).and_then(|m| m.last()) {
-            Some(last) if last["name"] == json!(model.name) => scene.json["meshes"].as_array().unwrap().len() - 1,
+            Some(last) if last["name"] == json!(name) => scene.json["meshes"].as_array().unwrap().len() - 1,
             _ => {
                 let meshes = array_mut(&mut scene.json, "meshes");
-                meshes.push(json!({ "name": model.name, "primitives": [] }));
-                nodes.push(json!({ "name": model.name, "mesh": meshes.len() - 1 }));
+                meshes.push(json!({ "name": name, "primitives": [] }));
+                nodes.push(json!({ "name": name, "mesh": meshes.len() - 1 }));
                 meshes.len() - 1
             }
         };
-        let prim = build_primitive(path, &model.mesh, opts.obj_normals, &mut scene.notes, &model.name)?;
+        let model = remap.model(&data, run.tris.clone());
+        let prim = build_primitive(path, &model, opts.obj_normals, &mut scene.notes, name)?;
         let mut pj = json!({ "attributes": {} });
-        if let Some(m) = model.mesh.material_id.filter(|&m| m < materials.len()) {
+        if let Some(m) = run.material.filter(|&m| m < materials.len()) {
             pj["material"] = json!(m);
         }
         let prims = scene.json["meshes"][mesh_idx]["primitives"].as_array_mut().expect("primitives array");
@@ -78,16 +86,183 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     if nodes.is_empty() {
         return Err(Error::input(path, "OBJ has no faces"));
     }
+    set_nodes(&mut scene, nodes);
+    Ok(scene)
+}
+
+/// A scene with no meshes yet, read from the OBJ or PLY file at `path`. UVs stay v up.
+fn empty_scene(path: &Path, opts: &ReadOptions, deps: Vec<std::path::PathBuf>) -> Scene {
+    Scene {
+        json: json!({ "asset": { "version": "2.0", "generator": concat!("bumpbake ", env!("CARGO_PKG_VERSION")) } }),
+        buffers: Vec::new(),
+        source: path.to_path_buf(),
+        base_dir: path.parent().map(|p| p.to_path_buf()).unwrap_or_default(),
+        allow_outside: opts.allow_outside,
+        uv_v_up: true,
+        notes: Vec::new(),
+        deps,
+        height_maps: Vec::new(),
+        ledger: Default::default(),
+        own_images: true,
+    }
+}
+
+fn set_nodes(scene: &mut Scene, nodes: Vec<Value>) {
     let roots: Vec<usize> = (0..nodes.len()).collect();
     scene.json["nodes"] = Value::Array(nodes);
     scene.json["scenes"] = json!([{ "nodes": roots }]);
     scene.json["scene"] = json!(0);
+}
+
+/// A PLY mesh as a scene: one node and mesh named after the file, one primitive built exactly
+/// as an OBJ face list with the same corners would be.
+pub fn ply_scene(path: &Path, ply: super::ply::PlyMesh, opts: &ReadOptions) -> Result<Scene> {
+    if ply.triangles.is_empty() {
+        return Err(Error::input(path, "PLY has no faces (a point cloud cannot be used as a mesh)"));
+    }
+    let name = path.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
+    let indices: Vec<u32> = ply.triangles.into_flattened();
+    let with = |present: bool| if present { indices.clone() } else { Vec::new() };
+    let model = Model {
+        normal_indices: with(!ply.normals.is_empty()),
+        texcoord_indices: with(!ply.uvs.is_empty()),
+        positions: ply.positions.into_flattened(),
+        normals: ply.normals.into_flattened(),
+        texcoords: ply.uvs.into_flattened(),
+        indices,
+    };
+    let mut scene = empty_scene(path, opts, Vec::new());
+    let prim = build_primitive(path, &model, opts.obj_normals, &mut scene.notes, &name)?;
+    scene.json["meshes"] = json!([{ "name": name, "primitives": [{ "attributes": {} }] }]);
+    scene.put_primitive(PrimRef { mesh: 0, primitive: 0 }, prim);
+    set_nodes(&mut scene, vec![json!({ "name": name, "mesh": 0 })]);
     Ok(scene)
+}
+
+/// A run of triangles with one name and one material: one glTF primitive.
+struct Run {
+    name: String,
+    material: Option<usize>,
+    tris: std::ops::Range<usize>,
+}
+
+/// Splits the triangles where tobj split its models: at every `o`/`g`, and at a `usemtl` that
+/// changes the material; runs without triangles are dropped.
+fn runs(data: &ObjData, ids: &HashMap<String, usize>) -> Vec<Run> {
+    let mut out = Vec::new();
+    let (mut name, mut material, mut start) = ("unnamed_object".to_string(), None, 0usize);
+    fn close(name: &str, material: Option<usize>, start: usize, at: usize, out: &mut Vec<Run>) {
+        if at > start {
+            out.push(Run { name: name.to_string(), material, tris: start..at });
+        }
+    }
+    for (at, s) in &data.statements {
+        let at = *at as usize;
+        match s {
+            Statement::Name(n) => {
+                close(&name, material, start, at, &mut out);
+                start = at;
+                name = n.clone();
+            }
+            Statement::Material(m) => {
+                let id = ids.get(m).copied();
+                if id != material {
+                    close(&name, material, start, at, &mut out);
+                    start = at;
+                    material = id;
+                }
+            }
+        }
+    }
+    close(&name, material, start, data.tri_v.len(), &mut out);
+    out
+}
+
+/// One run's corners with each attribute renumbered in first-use order, as tobj numbered a
+/// model's (so smooth normals and welding see what they always saw).
+#[derive(Default)]
+struct Model {
+    positions: Vec<f32>,
+    indices: Vec<u32>,
+    normals: Vec<f32>,
+    normal_indices: Vec<u32>,
+    texcoords: Vec<f32>,
+    texcoord_indices: Vec<u32>,
+}
+
+/// Global-to-local index maps, one per attribute, reset between runs by what they touched.
+struct Remaps {
+    maps: [Vec<u32>; 3],
+    touched: Vec<(usize, u32)>,
+}
+
+impl Remaps {
+    fn new(d: &ObjData) -> Remaps {
+        let m = |n: usize| vec![MISSING; n];
+        Remaps { maps: [m(d.positions.len()), m(d.uvs.len()), m(d.normals.len())], touched: Vec::new() }
+    }
+
+    /// The local index of global `g` of attribute `a`, and whether it is new.
+    fn local(&mut self, a: usize, g: u32, next: usize) -> (u32, bool) {
+        let slot = &mut self.maps[a][g as usize];
+        if *slot == MISSING {
+            *slot = next as u32;
+            self.touched.push((a, g));
+            (*slot, true)
+        } else {
+            (*slot, false)
+        }
+    }
+
+    fn model(&mut self, d: &ObjData, tris: std::ops::Range<usize>) -> Model {
+        let mut m = Model::default();
+        for t in &d.tri_v[tris.clone()] {
+            for &g in t {
+                let (l, new) = self.local(0, g, m.positions.len() / 3);
+                if new {
+                    m.positions.extend_from_slice(&d.positions[g as usize]);
+                }
+                m.indices.push(l);
+            }
+        }
+        // A corner without `vt` (`vn`) in a run where others have one takes the previous
+        // corner's (the first one's: the file's first), as tobj did.
+        let attrs: [(&[[u32; 3]], usize); 2] = [(&d.tri_t, 1), (&d.tri_n, 2)];
+        for (tri, a) in attrs {
+            let Some(run) = tri.get(tris.clone()) else { continue };
+            if run.iter().flatten().all(|&i| i == MISSING) {
+                continue;
+            }
+            let mut prev = 0;
+            for &g in run.iter().flatten() {
+                let g = if g == MISSING { prev } else { g };
+                prev = g;
+                let (values, indices) = if a == 1 {
+                    (&mut m.texcoords, &mut m.texcoord_indices)
+                } else {
+                    (&mut m.normals, &mut m.normal_indices)
+                };
+                let (l, new) = self.local(a, g, values.len() / (a + 1));
+                if new {
+                    if a == 1 {
+                        values.extend_from_slice(&d.uvs[g as usize]);
+                    } else {
+                        values.extend_from_slice(&d.normals[g as usize]);
+                    }
+                }
+                indices.push(l);
+            }
+        }
+        for (a, g) in self.touched.drain(..) {
+            self.maps[a][g as usize] = MISSING;
+        }
+        m
+    }
 }
 
 fn build_primitive(
     path: &Path,
-    m: &tobj::Mesh,
+    m: &Model,
     normals: NormalMode,
     notes: &mut Vec<String>,
     name: &str,

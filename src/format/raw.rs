@@ -6,10 +6,14 @@
 //! maps. Positions are in the mesh's world space: glTF node transforms are applied here (OBJ and
 //! PLY have none), normals through the normal matrix. UVs are in glTF's convention (v down).
 
-use crate::error::Result;
+use super::obj_parse::{ObjData, Statement, MISSING};
+use super::ply::PlyMesh;
+use crate::error::{Error, Result};
 use crate::scene::nodes::instances;
+use crate::scene::normals::unit_or_up;
 use crate::scene::{to_triangle_list, PrimRef, ReadOptions, Scene};
 use glam::{Mat3, Vec3};
+use rayon::prelude::*;
 use std::path::Path;
 
 /// A run of triangles that belong to one named part (OBJ `o`/`g`, a glTF node, a PLY file).
@@ -49,9 +53,94 @@ impl RawMesh {
 
 /// Reads any mesh file bumpbake reads as a [`RawMesh`]: every triangle primitive the scene shows,
 /// in world space, one part per node (named after the node, else its mesh).
+///
+/// OBJ and PLY take a fast path: the parsed arrays become the mesh as they are, with no Scene,
+/// no welding and no per-corner copies; `opts` matters only to glTF.
 pub fn read_raw(path: &Path, opts: &ReadOptions) -> Result<RawMesh> {
-    let scene = Scene::read(path, opts)?;
-    from_scene(&scene)
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "obj" => from_obj(path, super::obj_parse::parse_file(path)?),
+        "ply" => from_ply(path, super::ply::read_file(path)?),
+        _ => from_scene(&Scene::read(path, opts)?),
+    }
+}
+
+/// An OBJ file's arrays as a mesh: parts at `o`/`g` and at `usemtl` changes, UVs flipped to
+/// glTF's convention once, normals made unit (zero ones point up, as for every OBJ read).
+/// A kind of index some corners lack (a `vt` here and there) is dropped whole.
+pub fn from_obj(path: &Path, d: ObjData) -> Result<RawMesh> {
+    check_finite(path, &d.positions)?;
+    let complete = |t: &Vec<[u32; 3]>| !t.is_empty() && !t.par_iter().flatten().any(|&i| i == MISSING);
+    let (with_n, with_t) = (complete(&d.tri_n), complete(&d.tri_t));
+    let mut parts = Vec::new();
+    let mut cur = Part { name: "unnamed_object".into(), material: None, start: 0 };
+    for (at, s) in d.statements {
+        let next = match s {
+            Statement::Name(n) => Part { name: n, material: cur.material.clone(), start: at },
+            Statement::Material(m) if cur.material.as_deref() != Some(m.as_str()) => {
+                Part { name: cur.name.clone(), material: Some(m), start: at }
+            }
+            Statement::Material(_) => continue,
+        };
+        if at > cur.start {
+            parts.push(std::mem::replace(&mut cur, next));
+        } else {
+            cur = next;
+        }
+    }
+    if (d.tri_v.len() as u32) > cur.start {
+        parts.push(cur);
+    }
+    let mut out = RawMesh { positions: d.positions, triangles: d.tri_v, parts, ..Default::default() };
+    if with_n {
+        out.normals = d.normals;
+        out.normals.par_iter_mut().for_each(|n| *n = unit_or_up(*n));
+        out.normal_triangles = d.tri_n;
+    }
+    if with_t {
+        out.uvs = flip_v(d.uvs);
+        check_finite_uv(path, &out.uvs)?;
+        out.uv_triangles = d.tri_t;
+    }
+    Ok(out)
+}
+
+/// A PLY mesh as one part named after the file.
+pub fn from_ply(path: &Path, p: PlyMesh) -> Result<RawMesh> {
+    let name = path.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
+    let parts = if p.triangles.is_empty() { Vec::new() } else { vec![Part { name, material: None, start: 0 }] };
+    let mut out = RawMesh { positions: p.positions, parts, ..Default::default() };
+    if !p.normals.is_empty() {
+        out.normals = p.normals;
+        out.normals.par_iter_mut().for_each(|n| *n = unit_or_up(*n));
+        out.normal_triangles = p.triangles.clone();
+    }
+    if !p.uvs.is_empty() {
+        out.uvs = flip_v(p.uvs);
+        check_finite_uv(path, &out.uvs)?;
+        out.uv_triangles = p.triangles.clone();
+    }
+    out.triangles = p.triangles;
+    Ok(out)
+}
+
+fn flip_v(mut uvs: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
+    uvs.par_iter_mut().for_each(|uv| uv[1] = 1.0 - uv[1]);
+    uvs
+}
+
+fn check_finite(path: &Path, p: &[[f32; 3]]) -> Result<()> {
+    match p.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
+        Some(i) => Err(Error::input(path, format!("vertex {} has a non-finite coordinate", i + 1))),
+        None => Ok(()),
+    }
+}
+
+fn check_finite_uv(path: &Path, uv: &[[f32; 2]]) -> Result<()> {
+    match uv.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
+        Some(i) => Err(Error::input(path, format!("texture coordinate {} is not finite", i + 1))),
+        None => Ok(()),
+    }
 }
 
 /// A scene's shown triangle primitives as one [`RawMesh`] in world space.

@@ -1,0 +1,174 @@
+use super::*;
+
+fn parse(s: &str) -> ObjData {
+    parse_bytes(Path::new("t.obj"), s.as_bytes()).unwrap()
+}
+
+fn error(s: &str) -> String {
+    parse_bytes(Path::new("t.obj"), s.as_bytes()).unwrap_err().to_string()
+}
+
+#[test]
+fn every_listed_syntax() {
+    let d = parse(concat!(
+        "# comment\r\n",
+        "mtllib my lib.mtl\r\n",
+        "vn 0 0 1\n",
+        "vt .5 -0\n",
+        "v 1e-3 -0 +2.5E1\n",
+        "v 2 0 0 2\n",           // w divides
+        "v 0 1 0 0.5 0.5 0.5\n", // a colour, not kept
+        "  o  first part  \n",
+        "usemtl red\n",
+        "f 1/1/1 2//1 3/1 # trailing comment\n",
+        "vt 1 1 0\n", // a third vt number is ignored
+        "v 0 0 1\n",
+        "g\n",
+        "f -4/-2/-1 -3/-1 -2 -1\n",   // relative, a quad
+        "s off\nl 1 2\np 1\nf 1 2\n", // no surface
+        "usemtl  \tblue\n",
+    ));
+    assert_eq!(d.positions, vec![[1e-3, -0.0, 25.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    assert!(d.positions[0][1].is_sign_negative());
+    assert_eq!(d.uvs, vec![[0.5, -0.0], [1.0, 1.0]]);
+    assert_eq!(d.normals, vec![[0.0, 0.0, 1.0]]);
+    assert_eq!(d.tri_v, vec![[0, 1, 2], [0, 1, 2], [0, 2, 3]]);
+    assert_eq!(d.tri_t, vec![[0, MISSING, 0], [0, 1, MISSING], [0, MISSING, MISSING]]);
+    assert_eq!(d.tri_n, vec![[0, 0, MISSING], [0, MISSING, MISSING], [0, MISSING, MISSING]]);
+    assert_eq!(
+        d.statements,
+        vec![
+            (0, Statement::Name("first part".into())),
+            (0, Statement::Material("red".into())),
+            (1, Statement::Name("unnamed_object".into())),
+            (3, Statement::Material("blue".into())),
+        ]
+    );
+    assert_eq!(d.mtllibs, vec!["my lib.mtl".to_string()]);
+}
+
+#[test]
+fn a_polygon_is_fanned_from_its_first_corner() {
+    let d = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv -1 1 0\nf 1 2 3 4 5\n");
+    assert_eq!(d.tri_v, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
+    assert!(d.tri_t.is_empty() && d.tri_n.is_empty());
+}
+
+#[test]
+fn faces_may_come_before_what_they_name() {
+    let d = parse("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    assert_eq!(d.tri_v, vec![[0, 1, 2]]);
+    // vt/vn indices into a kind the file never defines are ignored (as tobj did).
+    let d = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n");
+    assert!(d.tri_t.is_empty() && d.tri_n.is_empty());
+}
+
+#[test]
+fn errors_name_the_line_and_the_way_out() {
+    let past = error("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 4\n");
+    assert!(
+        past.contains("t.obj") && past.contains("line 5") && past.contains("vertex index 4 is past the 3"),
+        "{past}"
+    );
+    assert!(error("v 0 0 0\nf 1 -2 1\n").contains("line 2: relative vertex index -2"));
+    assert!(error("v 0 0 0\nf 0 1 1\n").contains("index 0 (OBJ indices start at 1)"));
+    assert!(error("v 0 0 0\nvt 0 0\nv 1 x 0\n").contains("line 3: v: 'x' is not a number"));
+    assert!(error("v 0 0\n").contains("line 1: v has too few numbers"));
+    assert!(error("v 0 0 0 1 1\n").contains("v has 5 numbers"));
+    assert!(error("v 0 0 0 0\n").contains("w = 0"));
+    assert!(error("v 0 0 0\nf 1/1/1/1 1 1\n").contains("more than v/vt/vn"));
+    assert!(error("v 0 0 0\nf 1/a 1 1\n").contains("not v, v/vt"));
+    assert!(error("usemtl\n").contains("line 1: usemtl names no material"));
+    assert!(error("vt 1\n").contains("vt has too few numbers"));
+}
+
+#[test]
+fn floats_are_exactly_what_str_parse_gives() {
+    let tricky = [
+        "0",
+        "-0",
+        "+0.0",
+        ".5",
+        "5.",
+        "1e-3",
+        "1E+3",
+        "-1.5e-7",
+        "3.4028235e38",
+        "3.4028236e38",
+        "1e39",
+        "1.17549435e-38",
+        "1e-45",
+        "1.4e-45",
+        "7e-46",
+        "0.1",
+        "0.2",
+        "0.3",
+        "16777217",
+        "16777216.5",
+        "33554431",
+        "0.000000059604645",
+        "1.00000005960464477539",
+        "1.0000000596046448",
+        "1.000000059604644775390625",
+        "0.100000001490116119384765625",
+        "123456789012345678901234567890",
+        "0.00000000000000000000000000000000000001",
+        "9007199254740993",
+        "9007199254740992e-22",
+        "inf",
+        "-NaN",
+        "infinity",
+        "1e",
+        "e5",
+        ".",
+        "-",
+        "1.2.3",
+        "0x10",
+        "1_0",
+    ];
+    for t in tricky {
+        let want = t.parse::<f32>().ok();
+        let got = parse_f32(t.as_bytes());
+        assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "{t}");
+    }
+    // Every f32 midpoint neighbourhood and random decimals of every length.
+    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    for _ in 0..40_000 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        let f = f32::from_bits(x as u32 & 0x7F7F_FFFF);
+        let mid = (f as f64 + f32::from_bits(f.to_bits() + 1) as f64) / 2.0;
+        let digits = (x >> 40) as usize % 12 + 1;
+        for t in [format!("{f}"), format!("{mid:e}"), format!("{:.*e}", digits, mid), format!("{:.*}", digits, f)] {
+            assert_eq!(parse_f32(t.as_bytes()).map(f32::to_bits), t.parse::<f32>().ok().map(f32::to_bits), "{t}");
+        }
+    }
+}
+
+#[test]
+fn any_piece_size_gives_the_same_result() {
+    let mut s = String::from("mtllib a.mtl\no a\nvt 0 0\nvn 0 0 1\n");
+    for i in 0..40 {
+        s += &format!("v {i} {}.25 -{i}e-2\r\n", i * 3);
+        if i % 7 == 3 {
+            s += &format!("g part{i}\nusemtl m{}\n", i % 2);
+        }
+        if i >= 3 {
+            s += &format!("f -1/1/1 -2//1 -3/1 {}\n", i / 2 + 1);
+        }
+    }
+    let whole = parse(&s);
+    assert!(whole.tri_v.len() > 60);
+    for piece in [1, 2, 3, 5, 7, 16, 64, 1000] {
+        let d = parse_reader(Path::new("t.obj"), s.as_bytes(), piece).unwrap();
+        assert_eq!(d, whole, "piece {piece}");
+    }
+    // Errors keep their line numbers too.
+    let bad = format!("{s}f 1 2 999\n");
+    let lines = bad.lines().count();
+    for piece in [1, 3, 64, 1 << 20] {
+        let e = parse_reader(Path::new("t.obj"), bad.as_bytes(), piece).unwrap_err().to_string();
+        assert!(e.contains(&format!("line {lines}:")), "{e}");
+    }
+}
