@@ -142,7 +142,7 @@ impl Acc {
         let parsed: Vec<std::result::Result<Piece, (u64, String)>> =
             pieces.par_iter().zip(&bases).map(|(p, base)| Piece::parse(p, *base)).collect();
         for p in parsed {
-            let p = p.map_err(|(line, msg)| Error::input(path, format!("line {line}: {msg}")))?;
+            let p = p.map_err(|(line, msg)| Error::input(path, format!("OBJ line {line}: {msg}")))?;
             self.append(p);
         }
         self.lines = b.lines;
@@ -188,7 +188,7 @@ impl Acc {
                 return Err(Error::input(
                     path,
                     format!(
-                        "line {}: {what} index {} is past the {} defined in the file (indices start at 1; negative ones count back from the last)",
+                        "OBJ line {}: {what} index {} is past the {} defined in the file (indices start at 1; negative ones count back from the last)",
                         f.line,
                         f.index as u64 + 1,
                         totals[f.attr as usize]
