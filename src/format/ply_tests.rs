@@ -113,3 +113,14 @@ fn damage_is_a_clear_error() {
         assert!(e.contains(want), "{header:?}: {e}");
     }
 }
+
+#[test]
+fn the_fuzz_seeds_read_as_one_quad() {
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/ply_read");
+    for enc in ["ascii", "binary_little_endian", "binary_big_endian"] {
+        let f = d.join(format!("quad_{enc}.ply"));
+        let m = parse(&f, &std::fs::read(&f).unwrap()).unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [2, 1, 0]], "{enc}");
+        assert_eq!((m.positions[2], m.normals[2], m.uvs[3]), ([1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0]), "{enc}");
+    }
+}
