@@ -6,7 +6,8 @@
 # written and the machine-readable stdout of validate and inspect, plus inspect's human text.
 set -uo pipefail
 cd "$(dirname "$0")/.."
-bin=${1:-"${CARGO_TARGET_DIR:-target}/debug/bumpbake"}
+bin=${1:-"$(cargo metadata --format-version 1 --no-deps | sed 's/.*"target_directory":"\([^"]*\)".*/\1/')/debug/bumpbake"}
+[ -x "$bin" ] || { echo "output-hashes: no bumpbake at $bin (build it, or pass its path)" >&2; exit 2; }
 bin=$(realpath "$bin")
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
@@ -38,7 +39,8 @@ for m in $meshes; do
   fi
   hash "bake $m glb" "$out/$n.b.glb"
   run "validate json $m" "$bin" validate --format json "$m"
-  run "validate json tangents-out $m" "$bin" validate --format json "$out/$n.t.glb"
+  # from inside the scratch folder, so the paths in the report do not name it
+  run "validate json tangents-out $m" sh -c 'cd "$1" && "$2" validate --format json "$3"' _ "$out" "$bin" "$n.t.glb"
   run "inspect json $m" "$bin" inspect --json "$m"
   run "inspect $m" "$bin" inspect "$m"
   for v in shaded normal tangent handedness; do
