@@ -1,14 +1,15 @@
 //! Reading Wavefront OBJ (+ MTL) into the glTF model: the geometry through the parallel parser
 //! in `obj_parse.rs`, the MTL libraries through `tobj` (the only part of it still used).
 //!
-//! UVs are kept as the OBJ stores them (v up) while tangents are generated, which is what makes the
-//! frames identical to the reference on OBJ input; the writer flips them to glTF's v down.
+//! OBJ's UVs run v up; they are turned into glTF's v down here, once, so no stage after the
+//! reader knows the mesh came from an OBJ (MikkTSpace's sign flips with v, and the glTF `w` rule,
+//! the reference sign negated, flips it back: the frames are the same).
 
 use super::obj_parse::{self, ObjData, Statement, MISSING};
 use crate::error::{Error, Result};
 use crate::scene::normals::{flat_normals, smooth_normals, unit_or_up};
 use crate::scene::weld::weld;
-use crate::scene::{array_mut, HeightMapRef, NormalMode, PrimRef, ReadOptions, Scene, Stream};
+use crate::scene::{array_mut, HeightMapRef, NormalMode, PrimRef, Primitive, ReadOptions, Scene, SourceFormat, Stream};
 use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -54,7 +55,7 @@ fn build_scene(path: &Path, data: ObjData, opts: &ReadOptions) -> Result<Scene> 
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let (materials, material_ids, mtl_files) = load_materials(path, &base_dir, &data.mtllibs, opts)?;
 
-    let mut scene = empty_scene(path, opts, mtl_files);
+    let mut scene = empty_scene(path, opts, SourceFormat::Obj, mtl_files);
     for (i, m) in materials.iter().enumerate() {
         add_material(&mut scene, i, m)?;
     }
@@ -73,7 +74,8 @@ fn build_scene(path: &Path, data: ObjData, opts: &ReadOptions) -> Result<Scene> 
             }
         };
         let model = remap.model(&data, run.tris.clone());
-        let prim = build_primitive(path, &model, opts.obj_normals, &mut scene.notes, name)?;
+        let mut prim = build_primitive(path, &model, opts.obj_normals, &mut scene.notes, name)?;
+        uvs_to_gltf(&mut prim);
         let mut pj = json!({ "attributes": {} });
         if let Some(m) = run.material.filter(|&m| m < materials.len()) {
             pj["material"] = json!(m);
@@ -90,15 +92,15 @@ fn build_scene(path: &Path, data: ObjData, opts: &ReadOptions) -> Result<Scene> 
     Ok(scene)
 }
 
-/// A scene with no meshes yet, read from the OBJ or PLY file at `path`. UVs stay v up.
-fn empty_scene(path: &Path, opts: &ReadOptions, deps: Vec<std::path::PathBuf>) -> Scene {
+/// A scene with no meshes yet, read from the OBJ or PLY file at `path`.
+fn empty_scene(path: &Path, opts: &ReadOptions, format: SourceFormat, deps: Vec<std::path::PathBuf>) -> Scene {
     Scene {
         json: json!({ "asset": { "version": "2.0", "generator": concat!("bumpbake ", env!("CARGO_PKG_VERSION")) } }),
         buffers: Vec::new(),
         source: path.to_path_buf(),
         base_dir: path.parent().map(|p| p.to_path_buf()).unwrap_or_default(),
         allow_outside: opts.allow_outside,
-        uv_v_up: true,
+        source_format: format,
         notes: Vec::new(),
         deps,
         height_maps: Vec::new(),
@@ -131,8 +133,9 @@ pub fn ply_scene(path: &Path, ply: super::ply::PlyMesh, opts: &ReadOptions) -> R
         texcoords: ply.uvs.into_flattened(),
         indices,
     };
-    let mut scene = empty_scene(path, opts, Vec::new());
-    let prim = build_primitive(path, &model, opts.obj_normals, &mut scene.notes, &name)?;
+    let mut scene = empty_scene(path, opts, SourceFormat::Ply, Vec::new());
+    let mut prim = build_primitive(path, &model, opts.obj_normals, &mut scene.notes, &name)?;
+    uvs_to_gltf(&mut prim);
     scene.json["meshes"] = json!([{ "name": name, "primitives": [{ "attributes": {} }] }]);
     scene.put_primitive(PrimRef { mesh: 0, primitive: 0 }, prim);
     set_nodes(&mut scene, vec![json!({ "name": name, "mesh": 0 })]);
@@ -486,21 +489,18 @@ pub(crate) fn classify_normal_map(img: &image::DynamicImage) -> bool {
     (grey as f64) < 0.9 * n && b > 0.6 && (r - 0.5).abs() < 0.2 && (g - 0.5).abs() < 0.2
 }
 
-/// The same scene with every TEXCOORD flipped from v up (OBJ) to v down (glTF).
-pub fn flip_uvs_to_gltf(scene: &Scene) -> Result<Scene> {
-    let mut out = scene.clone();
-    for r in scene.primitives() {
-        let mut p = scene.primitive(r)?;
-        for (name, s) in p.attributes.iter_mut() {
-            if name.starts_with("TEXCOORD_") && s.format.component_type == crate::scene::accessor::FLOAT {
-                let uv: Vec<[f32; 2]> = s.to_f32::<2>().into_iter().map(|[u, v]| [u, 1.0 - v]).collect();
-                let template = s.template.take();
-                *s = Stream::from_f32("VEC2", &uv);
-                s.template = template;
-            }
+/// Every TEXCOORD of `p` flipped from v up (OBJ) to v down (glTF), per welded vertex.
+fn uvs_to_gltf(p: &mut Primitive) {
+    for (name, s) in p.attributes.iter_mut() {
+        if name.starts_with("TEXCOORD_") && s.format.component_type == crate::scene::accessor::FLOAT {
+            let uv: Vec<[f32; 2]> = s.to_f32::<2>().into_iter().map(|[u, v]| [u, 1.0 - v]).collect();
+            let template = s.template.take();
+            *s = Stream::from_f32("VEC2", &uv);
+            s.template = template;
         }
-        out.put_primitive(r, p);
     }
-    out.uv_v_up = false;
-    Ok(out)
 }
+
+#[cfg(test)]
+#[path = "obj_tests.rs"]
+mod tests;
