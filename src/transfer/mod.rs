@@ -16,6 +16,7 @@ pub mod raycast;
 
 use crate::error::{Error, Result};
 use crate::normalmap::{self, Convention, Depth, NormalData, NormalImage, PngSettings};
+use crate::progress::Reporter;
 use crate::report::Timings;
 use crate::scene::{PrimRef, ReadOptions, Scene};
 use glam::{Mat3A, Vec3A};
@@ -49,8 +50,8 @@ pub struct Settings {
     pub height_out: Option<PathBuf>,
     pub miss_mask: Option<PathBuf>,
     pub read: ReadOptions,
-    /// Draw a progress bar on stderr.
-    pub progress: bool,
+    /// Told how the rays advance (stage `bake --from`, in rows of the map).
+    pub progress: Reporter,
 }
 
 impl Default for Settings {
@@ -70,7 +71,7 @@ impl Default for Settings {
             height_out: None,
             miss_mask: None,
             read: ReadOptions::default(),
-            progress: false,
+            progress: Reporter::none(),
         }
     }
 }
@@ -129,9 +130,6 @@ pub struct Baked {
     pub report: TransferReport,
 }
 
-/// Progress callback: `(bands done, bands in all)`.
-pub type Progress<'a> = Option<&'a (dyn Fn(usize, usize) + Sync)>;
-
 /// Per texel, what its samples gave.
 #[derive(Clone, Copy, Default)]
 struct Texel {
@@ -144,8 +142,7 @@ struct Texel {
     hits: u16,
 }
 
-/// Bakes HIGH into every triangle primitive of LOW whose material is one of `materials`, with
-/// a progress bar when `s.progress` asks for one.
+/// Bakes HIGH into every triangle primitive of LOW whose material is one of `materials`.
 pub fn bake_materials(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
     let prims: Vec<PrimRef> = scene
         .primitives()
@@ -155,25 +152,11 @@ pub fn bake_materials(scene: &Scene, materials: &[usize], s: &Settings) -> Resul
             mat.map(|m| materials.contains(&(m as usize))).unwrap_or(false) && mesh::is_triangles(scene, r)
         })
         .collect();
-    let bar = if s.progress {
-        let b = indicatif::ProgressBar::new(s.height as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("bake --from [{bar:40}] {pos}/{len} rows ({elapsed})")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
-    let tick = |done: usize, all: usize| bar.set_position((done * s.height / all.max(1)) as u64);
-    let r = bake(scene, &prims, s, Some(&tick));
-    bar.finish_and_clear();
-    r
+    bake(scene, &prims, s)
 }
 
 /// Bakes HIGH into LOW's primitives `prims` (which must carry tangents already).
-pub fn bake(scene: &Scene, prims: &[PrimRef], s: &Settings, progress: Progress) -> Result<Baked> {
+pub fn bake(scene: &Scene, prims: &[PrimRef], s: &Settings) -> Result<Baked> {
     check(s)?;
     let mut t = Timings::default();
     let low = t.time("low", || mesh::low(scene, prims))?;
@@ -190,7 +173,9 @@ pub fn bake(scene: &Scene, prims: &[PrimRef], s: &Settings, progress: Progress) 
     let front = s.ray_front.unwrap_or(DEFAULT_REACH * low.diagonal);
     let back = s.ray_back.unwrap_or(DEFAULT_REACH * low.diagonal);
     let ctx = Ctx { low: &low, bvh: &bvh, normals: &normals, normal_index: &normal_index, front, back };
-    let (texels, mut c) = t.time("rays", || ctx.trace(s, progress));
+    s.progress.start("bake --from", s.height as u64, "rows");
+    let (texels, mut c) = t.time("rays", || ctx.trace(s));
+    s.progress.finish();
     crate::report::mem_mark("transfer rays");
     let (w, h) = (s.width, s.height);
     let mut n: Vec<[f32; 3]> = texels.iter().map(|x| x.normal).collect();
@@ -252,7 +237,7 @@ struct Sample {
 }
 
 impl Ctx<'_> {
-    fn trace(&self, s: &Settings, progress: Progress) -> (Vec<Texel>, Counts) {
+    fn trace(&self, s: &Settings) -> (Vec<Texel>, Counts) {
         let (w, h, n) = (s.width, s.height, s.samples);
         let low = self.low;
         let mut c = Counts::default();
@@ -280,7 +265,6 @@ impl Ctx<'_> {
             (b0..=b1).for_each(|b| per_band[b].push(i as u32));
         }
         let mut texels = vec![Texel::default(); w * h];
-        let done = std::sync::atomic::AtomicUsize::new(0);
         let band_counts: Vec<Counts> = texels
             .par_chunks_mut(BAND * w)
             .enumerate()
@@ -288,9 +272,7 @@ impl Ctx<'_> {
                 let y0 = b * BAND;
                 let y1 = (y0 + BAND).min(h);
                 let r = self.band(&edges, &per_band[b], y0, y1, w, n, out);
-                if let Some(p) = progress {
-                    p(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, bands);
-                }
+                s.progress.tick((y1 - y0) as u64);
                 r
             })
             .collect();
