@@ -327,8 +327,9 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
                 s.check(Code::NORMALMAP_NOT_DECODED, Some(f));
                 return s;
             }
+            let codec = bytes.as_deref().map(normal_image::Codec::sniff).unwrap_or(normal_image::Codec::Lossless);
             match bytes.and_then(|b| image::decode(&b)) {
-                Ok(img) => normal_image::check(&img, Convention::OpenGl, &wanted_by, &mut s),
+                Ok(img) => normal_image::check(&img, codec, Convention::OpenGl, &wanted_by, &mut s),
                 Err(e) => s.check(
                     Code::NORMALMAP_UNREADABLE,
                     Some(Finding::new(
