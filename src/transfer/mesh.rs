@@ -212,7 +212,7 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
             }
         }
         let uvs: Vec<[f32; 2]> = p.attr(&format!("TEXCOORD_{set}")).map(|s| s.to_f32()).unwrap_or_default();
-        out.uvs.extend(uvs.into_iter().map(|[u, v]| if scene.uv_v_up { [u, 1.0 - v] } else { [u, v] }));
+        out.uvs.extend(uvs);
         out.triangles.extend(p.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
         out.tri_part.resize(out.triangles.len(), part);
     }
