@@ -50,14 +50,6 @@ pub struct WriteStats {
 /// Builds every file the output consists of; the caller commits them (atomically, together).
 /// The binary data is not copied: the files borrow it from `scene`.
 pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs<'a>, WriteStats)> {
-    if scene.uv_v_up {
-        let flipped = super::obj::flip_uvs_to_gltf(scene)?;
-        return write_gltf(&flipped, out, opts).map(|(files, stats)| (files.into_owned(), stats));
-    }
-    write_gltf(scene, out, opts)
-}
-
-fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs<'a>, WriteStats)> {
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let glb = match ext.as_str() {
         "glb" => true,
