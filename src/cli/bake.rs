@@ -141,11 +141,15 @@ pub fn run(a: Args) -> Result<u8> {
         normal_convention: if transfer.is_some() { None } else { a.convention },
         keep_all: a.keep_all,
         bitangents: a.bitangents,
-        read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
+        read: ReadOptions {
+            allow_outside: a.io.allow_outside,
+            progress: a.batch.single_progress(a.io.inputs.len()),
+            ..Default::default()
+        },
         write: WriteOptions { images_external: a.images == "external", ..Default::default() },
         depfile: a.io.depfile.clone(),
     };
-    let opts = a.batch.options();
+    let opts = a.batch.options(a.io.inputs.len());
     let results = batch::run(&a.io.inputs, &opts, |input| {
         run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
     })?;
@@ -162,6 +166,7 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         return Err(Error::usage("--map-out, --height-out and --miss-mask take one input"));
     }
     let (width, height) = parse_size(&a.size)?;
+    let progress = a.batch.single_progress(a.io.inputs.len());
     Ok(Some(Settings {
         highs: a.from.clone(),
         cage: a.cage.clone(),
@@ -176,10 +181,10 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         convention: a.convention.unwrap_or_default(),
         height_out: a.height_out.clone(),
         miss_mask: a.miss_mask.clone(),
-        read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
+        read: ReadOptions { allow_outside: a.io.allow_outside, progress: progress.clone(), ..Default::default() },
         matching: a.matching,
         node: a.node.clone(),
-        progress: a.io.inputs.len() == 1 && batch::progress_wanted(a.batch.progress, a.batch.quiet || a.batch.json),
+        progress,
     }))
 }
 

@@ -5,6 +5,7 @@
 //! the reference sign negated, flips it back: the frames are the same).
 
 use crate::error::{Error, Result};
+use crate::progress::Counting;
 use crate::scene::normals::{flat_normals, smooth_normals, unit_or_up};
 use crate::scene::weld::weld;
 use crate::scene::{array_mut, HeightMapRef, NormalMode, PrimRef, Primitive, ReadOptions, Scene, SourceFormat, Stream};
@@ -18,18 +19,19 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     let mtl_error: RefCell<Option<Error>> = RefCell::new(None);
     let mtl_files: RefCell<Vec<std::path::PathBuf>> = RefCell::new(Vec::new());
     let load = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
-    let (models, materials) = tobj::load_obj_buf(&mut BufReader::new(bytes), &load, |mtl: &Path| {
-        let name = mtl.to_string_lossy();
-        mtl_files.borrow_mut().push(base_dir.join(mtl));
-        match super::uri::read(&name, &base_dir, path, opts.allow_outside) {
-            Ok(b) => tobj::load_mtl_buf(&mut BufReader::new(b.as_slice())),
-            Err(e) => {
-                *mtl_error.borrow_mut() = Some(e);
-                Err(tobj::LoadError::OpenFileFailed)
+    let (models, materials) =
+        tobj::load_obj_buf(&mut BufReader::new(Counting::new(bytes, &opts.progress)), &load, |mtl: &Path| {
+            let name = mtl.to_string_lossy();
+            mtl_files.borrow_mut().push(base_dir.join(mtl));
+            match super::uri::read(&name, &base_dir, path, opts.allow_outside) {
+                Ok(b) => tobj::load_mtl_buf(&mut BufReader::new(b.as_slice())),
+                Err(e) => {
+                    *mtl_error.borrow_mut() = Some(e);
+                    Err(tobj::LoadError::OpenFileFailed)
+                }
             }
-        }
-    })
-    .map_err(|e| Error::input(path, format!("malformed OBJ: {e}")))?;
+        })
+        .map_err(|e| Error::input(path, format!("malformed OBJ: {e}")))?;
     if let Some(e) = mtl_error.into_inner() {
         return Err(e);
     }

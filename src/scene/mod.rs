@@ -31,6 +31,8 @@ pub struct ReadOptions {
     pub allow_outside: bool,
     /// How to make normals for OBJ meshes that have none.
     pub obj_normals: NormalMode,
+    /// Told how a slow read (a large OBJ) advances, in bytes parsed.
+    pub progress: crate::progress::Reporter,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
