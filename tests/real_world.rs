@@ -234,8 +234,9 @@ fn every_command_on_every_corpus_file_succeeds_or_says_why() {
             assert!(report.to_string().contains("KHR_draco_mesh_compression"), "{stem}: says what it did not check");
         }
         run_ok(&["inspect", s(f)]);
-        // A correct map after glTF-Transform's JPEG or WebP coding passes strictly (issue 22).
-        if stem.ends_with(".jpeg") || stem.ends_with(".webp") {
+        // A correct map after glTF-Transform's JPEG or WebP coding passes strictly (issue 22);
+        // mirror_small's 8x8 normal map is flat (NORMALMAP_FLAT), so only the full-size one.
+        if stem.starts_with("NormalTangentMirrorTest") && (stem.ends_with(".jpeg") || stem.ends_with(".webp")) {
             let o = run(&["validate", "--strict", s(f)]);
             assert_eq!(o.status.code(), Some(0), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
         }
