@@ -1,29 +1,17 @@
 //! Running one job over many inputs: in parallel, one failure never stopping the others, results
-//! in input order so reports are deterministic, and a progress bar only where a person watches.
+//! in input order so reports are deterministic, and files done told to the caller's progress.
 
 use crate::error::{Error, Result};
-use std::io::IsTerminal;
+use crate::progress::Reporter;
 use std::path::{Path, PathBuf};
 
 /// How a batch runs.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct BatchOptions {
     /// Files processed at once; 0 means one per core.
     pub jobs: usize,
-    /// Show a progress bar even when stderr is not a terminal or CI is set.
-    pub force_progress: bool,
-    /// Never show a progress bar.
-    pub quiet: bool,
-}
-
-/// True when a progress bar should be drawn: a terminal, not CI, not quiet.
-pub fn progress_wanted(force: bool, quiet: bool) -> bool {
-    if quiet {
-        return false;
-    }
-    force
-        || (std::io::stderr().is_terminal()
-            && std::env::var_os("CI").map(|v| v.is_empty() || v == "false").unwrap_or(true))
+    /// Told of every file done (stage `files`).
+    pub progress: Reporter,
 }
 
 /// Runs `job` on every input, `opts.jobs` at a time; results come back in input order.
@@ -36,31 +24,21 @@ pub fn run<T: Send>(
         .num_threads(opts.jobs)
         .build()
         .map_err(|e| Error::usage(format!("cannot start {} worker threads: {e}", opts.jobs)))?;
-    let bar = (inputs.len() > 1 && progress_wanted(opts.force_progress, opts.quiet)).then(|| {
-        let b = indicatif::ProgressBar::new(inputs.len() as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} files {elapsed} {wide_msg}")
-                .expect("valid template"),
-        );
-        b
-    });
+    let progress = &opts.progress;
+    progress.start("files", inputs.len() as u64, "files");
     let results = pool.install(|| {
         use rayon::prelude::*;
         inputs
             .par_iter()
             .map(|p| {
                 let r = job(p);
-                if let Some(b) = &bar {
-                    b.set_message(p.display().to_string());
-                    b.inc(1);
-                }
+                progress.message(&p.display().to_string());
+                progress.tick(1);
                 r
             })
             .collect()
     });
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    progress.finish();
     Ok(results)
 }
 

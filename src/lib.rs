@@ -11,6 +11,7 @@
 //! - [`preview`]: a CPU renderer of the reference shading model (`shaders/` in GLSL).
 //! - [`transfer`]: high-poly to low-poly normal-map baking (`bake --from`).
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
+//! - [`progress`]: how long work reports its progress; the caller draws it (or not).
 //! - [`bench`](mod@bench): error against run time (`bumpbake bench ...`).
 
 pub mod bake;
@@ -22,6 +23,7 @@ pub mod inspect;
 pub mod normalmap;
 pub mod output;
 pub mod preview;
+pub mod progress;
 pub mod report;
 pub mod scene;
 pub mod tangent;

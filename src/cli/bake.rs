@@ -6,7 +6,7 @@ use bumpbake::batch;
 use bumpbake::format::WriteOptions;
 use bumpbake::normalmap::{Channel, Convention, Filter};
 use bumpbake::scene::ReadOptions;
-use bumpbake::transfer::Settings;
+use bumpbake::transfer::{Match, Settings};
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -43,7 +43,8 @@ pub struct Args {
     /// With --from: texels of padding around UV islands.
     #[arg(long, default_value_t = 16, requires = "from")]
     pub padding: usize,
-    /// With --from: also write the map to this file (.png, .tif, .exr; --convention, --bits16).
+    /// With --from: also write the map to this file (.png, .tif, .exr; --convention, --bits16);
+    /// with several materials, one file each, named `<stem>_<material>.<ext>`.
     #[arg(long, requires = "from")]
     pub map_out: Option<PathBuf>,
     /// With --from: write the height map (signed distance LOW to HIGH, 16-bit PNG).
@@ -52,10 +53,18 @@ pub struct Args {
     /// With --from: write where rays missed HIGH (8-bit PNG, white: every ray of the texel missed).
     #[arg(long, requires = "from")]
     pub miss_mask: Option<PathBuf>,
+    /// With --from: pair LOW and HIGH parts by name (`ring_low` bakes only from `ring_high`; also
+    /// `_lo`/`_hi`, any case, before a `.001` number), or let every part see all of HIGH.
+    #[arg(long = "match", value_enum, default_value_t = Match::Auto, requires = "from")]
+    pub matching: Match,
+    /// With --from: the node to bake a LOW mesh through when several nodes show it.
+    #[arg(long, requires = "from")]
+    pub node: Option<String>,
     /// Normal map to attach (PNG/JPEG kept, WebP/TIFF/EXR stored as PNG; DirectX converted to glTF's +Y).
     #[arg(long)]
     pub normal: Option<PathBuf>,
-    /// The material that gets the map (default: those with a bump map, or the only one).
+    /// The material that gets the map (default: those with a bump map, or the only one; with
+    /// --from, every material LOW's triangles use, each its own map).
     #[arg(long)]
     pub material: Option<String>,
     /// Strength S: how tall the whole black-to-white height range stands, in texels.
@@ -132,11 +141,15 @@ pub fn run(a: Args) -> Result<u8> {
         normal_convention: if transfer.is_some() { None } else { a.convention },
         keep_all: a.keep_all,
         bitangents: a.bitangents,
-        read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
+        read: ReadOptions {
+            allow_outside: a.io.allow_outside,
+            progress: a.batch.single_progress(a.io.inputs.len()),
+            ..Default::default()
+        },
         write: WriteOptions { images_external: a.images == "external", ..Default::default() },
         depfile: a.io.depfile.clone(),
     };
-    let opts = a.batch.options();
+    let opts = a.batch.options(a.io.inputs.len());
     let results = batch::run(&a.io.inputs, &opts, |input| {
         run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
     })?;
@@ -153,6 +166,7 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         return Err(Error::usage("--map-out, --height-out and --miss-mask take one input"));
     }
     let (width, height) = parse_size(&a.size)?;
+    let progress = a.batch.single_progress(a.io.inputs.len());
     Ok(Some(Settings {
         highs: a.from.clone(),
         cage: a.cage.clone(),
@@ -167,8 +181,10 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         convention: a.convention.unwrap_or_default(),
         height_out: a.height_out.clone(),
         miss_mask: a.miss_mask.clone(),
-        read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
-        progress: a.io.inputs.len() == 1 && batch::progress_wanted(a.batch.progress, a.batch.quiet || a.batch.json),
+        read: ReadOptions { allow_outside: a.io.allow_outside, progress: progress.clone(), ..Default::default() },
+        matching: a.matching,
+        node: a.node.clone(),
+        progress,
     }))
 }
 

@@ -3,6 +3,7 @@
 
 use bumpbake::batch;
 use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap};
+use bumpbake::progress::Reporter;
 use bumpbake::{Error, Result};
 use clap::builder::TypedValueParser;
 use std::path::{Path, PathBuf};
@@ -124,13 +125,13 @@ pub fn run(args: Args) -> Result<u8> {
     };
     let results = if args.heights.len() == 1 {
         // One map: a bar over its rows, for big maps on a terminal.
-        let bar = progress_bar(&args);
-        let tick = |rows: usize| bar.inc(rows as u64);
+        let bar = progress(&args);
+        let tick = |rows: usize| bar.tick(rows as u64);
         let r = convert(&args.heights[0], &outputs[0]).and_then(|c| nm::convert_file(&c, Some(&tick)));
-        bar.finish_and_clear();
+        bar.finish();
         vec![r]
     } else {
-        let opts = args.batch.options();
+        let opts = args.batch.options(args.heights.len());
         batch::run(&args.heights, &opts, |input| {
             convert(input, super::report::paired(&args.heights, &outputs, input))
                 .and_then(|c| nm::convert_file(&c, None))
@@ -161,10 +162,11 @@ pub fn run(args: Args) -> Result<u8> {
     })
 }
 
-/// A bar on a terminal for maps big enough to wait for; nothing when piped or under CI.
-fn progress_bar(args: &Args) -> indicatif::ProgressBar {
-    if !batch::progress_wanted(args.batch.progress, args.batch.quiet) {
-        return indicatif::ProgressBar::hidden();
+/// Rows done, told to a bar on a terminal for maps big enough to wait for; nothing when piped or
+/// under CI.
+fn progress(args: &Args) -> Reporter {
+    if !super::progress::wanted(args.batch.progress, args.batch.quiet) {
+        return Reporter::none();
     }
     // The header is read again by the conversion; this costs microseconds and keeps the
     // library free of terminal concerns.
@@ -175,15 +177,10 @@ fn progress_bar(args: &Args) -> indicatif::ProgressBar {
         .filter(|(w, h)| (*w as u64) * (*h as u64) >= 4 << 20 && (*w as u64) * (*h as u64) <= args.max_pixels);
     match rows {
         Some((_, h)) => {
-            let bar = indicatif::ProgressBar::new(h as u64);
-            bar.set_style(
-                indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows ({elapsed})")
-                    .unwrap()
-                    .progress_chars("=> "),
-            );
-            bar.set_message(format!("normalmap {}", args.heights[0].display()));
+            let bar = super::progress::reporter(true);
+            bar.start(&format!("normalmap {}", args.heights[0].display()), h as u64, "rows");
             bar
         }
-        None => indicatif::ProgressBar::hidden(),
+        None => Reporter::none(),
     }
 }

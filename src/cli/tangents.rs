@@ -53,6 +53,7 @@ pub fn run(a: Args) -> Result<u8> {
                 Normals::Flat => NormalMode::Flat,
                 Normals::Smooth => NormalMode::Smooth,
             },
+            progress: a.batch.single_progress(a.io.inputs.len()),
         },
         apply: ApplyOptions {
             all: a.all,
@@ -62,7 +63,7 @@ pub fn run(a: Args) -> Result<u8> {
         write: WriteOptions { embed: a.embed, ..Default::default() },
         depfile: a.io.depfile.clone(),
     };
-    let opts = a.batch.options();
+    let opts = a.batch.options(a.io.inputs.len());
     let results = batch::run(&a.io.inputs, &opts, |input| {
         run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
     })?;

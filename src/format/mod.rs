@@ -38,7 +38,11 @@ impl Scene {
     pub fn read_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
         if ext == "obj" {
-            obj::read(path, bytes, opts)
+            let name = path.file_name().map(|n| n.to_string_lossy()).unwrap_or_default();
+            opts.progress.start(&format!("read {name}"), bytes.len() as u64, "bytes");
+            let scene = obj::read(path, bytes, opts);
+            opts.progress.finish();
+            scene
         } else if bytes.starts_with(b"glTF") || ext == "glb" {
             gltf_read::read_glb(path, bytes, opts)
         } else if ext == "gltf" || bytes.first().map(|b| *b == b'{').unwrap_or(false) {

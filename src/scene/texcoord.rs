@@ -1,6 +1,6 @@
-//! Which UV sets (`TEXCOORD_n`) a material's textures read, which a primitive lacks, and how a
-//! group of primitives and the materials they share can renumber their sets so that only the
-//! read ones remain, numbered from 0 without gaps (glTF wants `TEXCOORD_0..n`).
+//! Which UV sets (`TEXCOORD_n`) a material's textures read, and how a group of primitives and
+//! the materials they share can renumber their sets so that only the read ones remain, numbered
+//! from 0 without gaps (glTF wants `TEXCOORD_0..n`).
 
 use serde_json::{json, Value};
 use std::collections::{BTreeMap, BTreeSet};
@@ -35,31 +35,6 @@ pub fn effective_set(info: &Value) -> u32 {
 fn named_sets(info: &Value) -> impl Iterator<Item = u32> {
     let base = info.get("texCoord").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
     [base, effective_set(info)].into_iter()
-}
-
-/// The sets a material's textures read (effective sets only).
-pub fn read_sets(material: Option<&Value>) -> BTreeSet<u32> {
-    let mut sets = BTreeSet::new();
-    if let Some(m) = material {
-        texture_infos(m, &mut |_, t| {
-            sets.insert(effective_set(t));
-        });
-    }
-    sets
-}
-
-/// Each texture of `material` that reads a set for which `has_set` is false, as
-/// `(texture key, set)`, e.g. `("normalTexture", 0)`.
-pub fn missing_sets(material: &Value, has_set: impl Fn(u32) -> bool) -> Vec<(String, u32)> {
-    let mut out = Vec::new();
-    texture_infos(material, &mut |k, t| {
-        for set in named_sets(t) {
-            if !has_set(set) && !out.contains(&(k.to_string(), set)) {
-                out.push((k.to_string(), set));
-            }
-        }
-    });
-    out
 }
 
 /// What renumbering needs to know of one primitive.

@@ -31,7 +31,7 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
         })
         .collect::<Result<Vec<_>>>()?;
     let quiet = a.json;
-    let r = super::bench::with_scratch("transfer", |exe, dir| {
+    let r = super::shared::with_scratch("transfer", |exe, dir| {
         bumpbake::bench::transfer::run(exe, dir, &quality, a.runs, |row| {
             if !quiet {
                 eprintln!(
@@ -45,6 +45,6 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
             }
         })
     })?;
-    super::bench::print(&r, a.json, bumpbake::bench::transfer::table)?;
+    super::shared::print(&r, a.json, bumpbake::bench::transfer::table)?;
     Ok(0)
 }
