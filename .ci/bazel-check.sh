@@ -3,7 +3,7 @@
 # 127.0.0.1): "machine" A builds and tests it, "machine" B (another checkout, another output base)
 # must then be all remote cache hits with byte-identical outputs; editing one input re-runs exactly
 # the actions that depend on it; an undeclared input fails in the sandbox with bumpbake's message.
-# Needs target/debug/bumpbake (cargo test or cargo build makes it).
+# Needs the debug bumpbake in cargo's target directory (cargo test or cargo build makes it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 echo "== Bazel example: a shared HTTP remote cache across two output bases"
@@ -18,7 +18,7 @@ if [ ${#need[@]} -gt 0 ]; then
 fi
 t_install=$(( $(date +%s) - t0 ))
 
-bin="$PWD/target/debug/bumpbake"
+bin="$(bash .ci/target-dir.sh)/debug/bumpbake"
 [ -x "$bin" ] || { echo "bazel-check: no $bin (run cargo build first)"; exit 1; }
 work=$(mktemp -d)
 chmod 755 "$work"

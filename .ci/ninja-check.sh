@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Runs examples/build.ninja on a copy of the fixtures, then touches one input and checks that
 # exactly the outputs depending on it rebuild (Ninja learns the dependencies from bumpbake's
-# depfiles). Needs target/debug/bumpbake (cargo test or cargo build makes it).
+# depfiles). Needs the debug bumpbake in cargo's target directory (cargo test or cargo build makes it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v ninja >/dev/null 2>&1; then
   echo "== installing ninja-build"
   apt-get update -qq && apt-get install -y -qq ninja-build
 fi
-bin="$PWD/target/debug/bumpbake"
+bin="$(bash .ci/target-dir.sh)/debug/bumpbake"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cp -r fixtures "$work/fixtures"

@@ -345,9 +345,38 @@ fn touching_parts_bake_apart() {
     let (most, n) = diff(&matched, &alone, &ring_rows);
     assert!(most == 0, "the ring's map depends on the cap: {n} texels differ by up to {most}");
 
+    // The same HIGH as an OBJ whose groups are the parts.
+    let op = d.join("high.obj");
+    std::fs::write(&op, obj(&[("ring_high", &ring_high), ("cap_high", &cap_high)])).unwrap();
+    let rep = bake(&lp, &[&op], &d.join("obj.glb"), &[]);
+    assert_eq!(rep["transfer"]["pairs"][0], json!({ "low": ["ring_low"], "high": ["ring_high"] }));
+    let (most, n) = diff(&map_of(&d.join("obj.glb"), 0), &alone, &ring_rows);
+    assert!(most == 0, "OBJ groups: {n} texels differ by up to {most}");
+
     bake(&lp, &[&hp], &d.join("bled.glb"), &["--match", "none"]);
     let (most, n) = diff(&map_of(&d.join("bled.glb"), 0), &alone, &ring_rows);
     assert!(most > 30 && n > 100, "without matching the cap should bleed into the ring ({n} texels, {most} levels)");
+}
+
+/// An OBJ with one group per named mesh (positions, normals; no UVs).
+fn obj(parts: &[(&str, &Mesh)]) -> String {
+    let mut o = String::new();
+    let mut base = 1;
+    for (name, m) in parts {
+        o += &format!("g {name}\n");
+        for p in &m.positions {
+            o += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        for n in &m.normals {
+            o += &format!("vn {} {} {}\n", n[0], n[1], n[2]);
+        }
+        for t in m.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize + base);
+            o += &format!("f {a}//{a} {b}//{b} {c}//{c}\n");
+        }
+        base += m.positions.len();
+    }
+    o
 }
 
 /// Two materials on one LOW mesh: two maps, each the plain map where its triangles are, and the

@@ -251,7 +251,8 @@ pub fn high(
                 h.normal_index.extend(tris.iter().map(|t| t.map(|i| b + i - lo)));
             }
         } else {
-            h.normals.extend(raw.normals.iter().map(|&v| Vec3A::from(v).normalize_or_zero()));
+            // Already unit (normalised once, after the normal matrix).
+            h.normals.extend(raw.normals.iter().map(|&v| Vec3A::from(v)));
             h.normal_index.extend(raw.normal_triangles.iter().map(|t| t.map(|i| base_n + i)));
         }
         h.corners.extend(raw.triangles.iter().map(|t| t.map(|i| local(dvec(raw.positions[i as usize]), origin))));

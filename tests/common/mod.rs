@@ -34,6 +34,20 @@ pub fn validated_dir(test: &str) -> PathBuf {
     fresh(Path::new(env!("CARGO_TARGET_TMPDIR")).join("validated").join(test))
 }
 
+/// Records beside `out` (in `OUT.input.json`) the input it was written from, so that CI's
+/// Khronos check (`.ci/validate-gltf.js`) holds `out` to "no issue its input does not have"
+/// instead of "no issue at all". `explained` lists codes bumpbake's report says it could not
+/// avoid, with why.
+pub fn record_input(out: &Path, input: &Path, explained: &[(&str, &str)]) {
+    let input = std::fs::canonicalize(input).unwrap_or_else(|e| panic!("{}: {e}", input.display()));
+    let explained: serde_json::Map<String, Value> =
+        explained.iter().map(|(c, why)| (c.to_string(), Value::from(*why))).collect();
+    let mut name = out.as_os_str().to_owned();
+    name.push(".input.json");
+    std::fs::write(name, serde_json::to_vec_pretty(&json!({ "input": input, "explained": explained })).unwrap())
+        .unwrap();
+}
+
 /// A fresh folder for scratch files (inputs the tests build, outputs not meant to validate).
 pub fn scratch_dir(test: &str) -> PathBuf {
     fresh(Path::new(env!("CARGO_TARGET_TMPDIR")).join("scratch").join(test))
