@@ -77,6 +77,10 @@ pub struct ImageInfo {
     pub height: Option<u32>,
     pub color: Option<String>,
     pub bits_per_channel: Option<u16>,
+    /// How the pixels are stored, for formats with variants (KTX2: `Basis Universal UASTC +
+    /// Zstandard`); omitted otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub variant: Option<String>,
     pub error: Option<String>,
 }
 
@@ -169,6 +173,7 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
         height: None,
         color: None,
         bits_per_channel: None,
+        variant: None,
         error: None,
     };
     match scene.image_bytes(i) {
@@ -185,6 +190,7 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
                     info.height = Some(h.height);
                     info.color = Some(h.colour.to_string());
                     info.bits_per_channel = Some(h.bits_per_channel);
+                    info.variant = h.variant;
                 }
                 Err(e) => info.error = Some(e),
             }
@@ -260,11 +266,12 @@ impl Inspection {
             match (&i.error, i.width) {
                 (None, Some(w)) => {
                     s += &format!(
-                        "  image {}: {}x{} {} {}-bit {} ({} bytes, {})\n",
+                        "  image {}: {}x{} {}{} {}-bit {} ({} bytes, {})\n",
                         i.index,
                         w,
                         i.height.unwrap_or(0),
                         i.format.as_deref().unwrap_or("?"),
+                        i.variant.as_ref().map(|v| format!(" ({v})")).unwrap_or_default(),
                         i.bits_per_channel.unwrap_or(0),
                         i.color.as_deref().unwrap_or(""),
                         i.bytes,

@@ -44,3 +44,10 @@ fn image_decode_regressions() {
         let _ = bumpbake::format::image::decode(&std::fs::read(&f).unwrap());
     }
 }
+
+#[test]
+fn ktx2_read_regressions() {
+    for f in inputs("ktx2_read") {
+        let _ = bumpbake::format::image::decode(&std::fs::read(&f).unwrap());
+    }
+}

@@ -4,8 +4,9 @@
 //! way.
 //!
 //! Formats are told by their magic bytes, never by a file name or a glTF `mimeType`: PNG, JPEG,
-//! WebP (lossy and lossless), TIFF and OpenEXR are decoded; KTX2 and the other formats glTF
-//! extensions allow are named in the error, so that callers can say plainly what was not read.
+//! WebP (lossy and lossless), TIFF, OpenEXR and KTX2 (Basis Universal and the plain formats:
+//! `super::ktx2`) are decoded; the other formats glTF extensions allow, and the KTX2 variants
+//! not read, are named in the error, so that callers can say plainly what was not read.
 //!
 //! Decoding does not trust the file. An image header can claim any size (a 100-byte PNG can say
 //! it is 200000 x 200000 pixels); decoding it blindly would try to allocate 160 GB. The header is
@@ -69,7 +70,7 @@ pub enum Kind {
 }
 
 /// The formats bumpbake decodes, for messages.
-pub const DECODED: &str = "PNG, JPEG, WebP, TIFF, OpenEXR";
+pub const DECODED: &str = "PNG, JPEG, WebP, TIFF, OpenEXR, KTX2";
 
 impl Kind {
     /// Recognises a format by its first bytes.
@@ -110,6 +111,7 @@ impl Kind {
             "webp" => Some(Kind::WebP),
             "tif" | "tiff" => Some(Kind::Tiff),
             "exr" => Some(Kind::OpenExr),
+            "ktx2" => Some(Kind::Ktx2),
             _ => None,
         }
     }
@@ -131,9 +133,9 @@ impl Kind {
         }
     }
 
-    /// Whether [`decode`] reads this format.
+    /// Whether [`decode`] reads this format (for KTX2, some of its variants: [`not_decoded_why`]).
     pub fn is_decoded(self) -> bool {
-        self.format().is_some()
+        self.format().is_some() || self == Kind::Ktx2
     }
 
     fn format(self) -> Option<ImageFormat> {
@@ -152,7 +154,6 @@ impl Kind {
 fn not_decoded(kind: Kind) -> String {
     match kind {
         Kind::Unknown => format!("not an image in a format bumpbake reads ({DECODED})"),
-        Kind::Ktx2 => format!("a KTX2 (Basis Universal) image, which bumpbake does not decode (it reads {DECODED})"),
         k => format!("a {} image, which bumpbake does not decode (it reads {DECODED})", k.name()),
     }
 }
@@ -181,6 +182,18 @@ fn describe(kind: Kind, e: ImageError) -> String {
     }
 }
 
+/// Why bumpbake will not decode these bytes, when their header says so: a format it does not
+/// read, or a KTX2 variant it does not read (a block-compressed vkFormat, a cube map). `None`
+/// for everything else, broken files included: decoding those says what is wrong.
+pub fn not_decoded_why(bytes: &[u8]) -> Option<String> {
+    match Kind::sniff(bytes) {
+        Kind::Ktx2 => super::ktx2::not_decoded(bytes),
+        Kind::Unknown => None,
+        k if !k.is_decoded() => Some(not_decoded(k)),
+        _ => None,
+    }
+}
+
 fn reader<R: std::io::BufRead + std::io::Seek>(head: &[u8], source: R) -> Result<(Kind, ImageReader<R>), String> {
     let kind = Kind::sniff(head);
     let format = kind.format().ok_or_else(|| not_decoded(kind))?;
@@ -204,6 +217,9 @@ pub fn dimensions(bytes: &[u8]) -> Result<(u32, u32), String> {
 
 /// [`dimensions`] under other limits.
 pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Result<(u32, u32), String> {
+    if Kind::sniff(bytes) == Kind::Ktx2 {
+        return super::ktx2::dimensions_within(bytes, limits);
+    }
     let (kind, mut r) = reader(bytes, Cursor::new(bytes))?;
     // Only the header is read here; the size checks below give the clearer message.
     let mut header_only = image::Limits::default();
@@ -223,11 +239,18 @@ pub struct Header {
     /// `grey`, `grey+alpha`, `RGB` or `RGBA`.
     pub colour: &'static str,
     pub bits_per_channel: u16,
+    /// How the pixels are stored, where the format has variants (KTX2: `Basis Universal UASTC +
+    /// Zstandard`, `R8G8_UNORM + zlib`).
+    pub variant: Option<String>,
 }
 
 /// Reads only the header: format, size and sample layout. Nothing is decoded and the size is not
 /// checked against the limits (describing a huge image is fine; decoding it is not).
 pub fn header(bytes: &[u8]) -> Result<Header, String> {
+    if Kind::sniff(bytes) == Kind::Ktx2 {
+        let (width, height, colour, bits_per_channel, variant) = super::ktx2::describe(bytes)?;
+        return Ok(Header { kind: Kind::Ktx2, width, height, colour, bits_per_channel, variant: Some(variant) });
+    }
     let (kind, mut r) = reader(bytes, Cursor::new(bytes))?;
     let mut header_only = image::Limits::default();
     header_only.max_alloc = Some(MAX_ALLOC);
@@ -241,7 +264,8 @@ pub fn header(bytes: &[u8]) -> Result<Header, String> {
         (true, false) => "RGB",
         (true, true) => "RGBA",
     };
-    Ok(Header { kind, width, height, colour, bits_per_channel: ct.bits_per_pixel() / ct.channel_count() as u16 })
+    let bits_per_channel = ct.bits_per_pixel() / ct.channel_count() as u16;
+    Ok(Header { kind, width, height, colour, bits_per_channel, variant: None })
 }
 
 /// Refuses empty images and those past the texture limits.
@@ -274,6 +298,9 @@ pub fn decode(bytes: &[u8]) -> Result<DynamicImage, String> {
 
 /// Decodes an image after checking its header against `limits`.
 pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
+    if Kind::sniff(bytes) == Kind::Ktx2 {
+        return super::ktx2::decode_within(bytes, limits);
+    }
     dimensions_within(bytes, limits)?;
     if Kind::sniff(bytes) == Kind::Jpeg && !jpeg_is_whole(bytes) {
         return Err("cannot decode as JPEG: the file ends early (truncated)".into());
@@ -321,8 +348,9 @@ pub fn read_file(path: &std::path::Path, max_pixels: u64) -> crate::error::Resul
         }
     }
     let limits = Limits::file(max_pixels);
-    if Kind::sniff(&head) == Kind::Jpeg {
-        // Whole in memory, to check its end: JPEGs are small beside their pixels.
+    if matches!(Kind::sniff(&head), Kind::Jpeg | Kind::Ktx2) {
+        // Whole in memory: a JPEG to check its end, a KTX2 to follow its index; both are small
+        // beside their pixels.
         let bytes = std::fs::read(path).map_err(open)?;
         return decode_within(&bytes, &limits).map_err(|m| Error::input(path, m));
     }
@@ -365,20 +393,18 @@ impl crate::scene::Scene {
     }
 
     /// The image of `texture` to decode, with its bytes: the first of [`Self::texture_images`]
-    /// not in a format bumpbake knows and does not decode. Also returns the images passed over, with their formats, so
-    /// that callers can say what was not read.
+    /// not in a format bumpbake knows and does not decode. Also returns the images passed over, with
+    /// their formats and why, so that callers can say what was not read.
     pub fn texture_image_to_decode(&self, texture: usize) -> crate::error::Result<TextureChoice> {
         let mut choice = TextureChoice::default();
         for ti in self.texture_images(texture) {
             let bytes = self.image_bytes(ti.image)?;
             // Bytes in no format at all are a broken image, for the decoder to refuse: only
-            // formats known and not decoded (KTX2, AVIF, ...) are passed over.
-            let kind = Kind::sniff(&bytes);
-            let readable = kind.is_decoded() || kind == Kind::Unknown;
-            if choice.chosen.is_none() && readable {
-                choice.chosen = Some((ti, bytes));
-            } else if !readable {
-                choice.passed_over.push((ti, kind));
+            // formats (and KTX2 variants) known and not decoded are passed over.
+            match not_decoded_why(&bytes) {
+                None if choice.chosen.is_none() => choice.chosen = Some((ti, bytes)),
+                None => {}
+                Some(why) => choice.passed_over.push((ti, Kind::sniff(&bytes), why)),
             }
         }
         Ok(choice)
@@ -390,8 +416,8 @@ impl crate::scene::Scene {
 pub struct TextureChoice {
     /// The image to decode and its encoded bytes.
     pub chosen: Option<(TextureImage, Vec<u8>)>,
-    /// Images of the texture in formats bumpbake does not decode.
-    pub passed_over: Vec<(TextureImage, Kind)>,
+    /// Images of the texture in formats bumpbake does not decode, and why.
+    pub passed_over: Vec<(TextureImage, Kind, String)>,
 }
 
 impl TextureChoice {
@@ -403,16 +429,16 @@ impl TextureChoice {
         let what: Vec<String> = self
             .passed_over
             .iter()
-            .map(|(ti, k)| match ti.extension {
-                Some(ext) => format!("image {} ({}, {ext})", ti.image, k.name()),
-                None => format!("image {} ({})", ti.image, k.name()),
+            .map(|(ti, k, why)| match ti.extension {
+                Some(ext) => format!("image {} ({}, {ext}) not decoded: {why}", ti.image, k.name()),
+                None => format!("image {} ({}) not decoded: {why}", ti.image, k.name()),
             })
             .collect();
         let then = match &self.chosen {
             Some((ti, _)) => format!("image {} is used instead", ti.image),
             None => "the texture is left out".to_string(),
         };
-        Some(format!("texture {texture}: {} not decoded (bumpbake reads {DECODED}); {then}", what.join(", ")))
+        Some(format!("texture {texture}: {}; {then}", what.join("; ")))
     }
 }
 
@@ -468,7 +494,7 @@ mod tests {
     fn formats_not_decoded_and_broken_files_are_named_in_words() {
         let ktx2 = [0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB, 0x0D, 0x0A, 0x1A, 0x0A, 0, 0, 0, 0];
         let e = decode(&ktx2).unwrap_err();
-        assert!(e.contains("KTX2") && e.contains("does not decode"), "{e}");
+        assert!(e.starts_with("cannot decode as KTX2: the file ends early"), "{e}");
         let e = decode(b"GIF89a\x01\x00\x01\x00").unwrap_err();
         assert!(e.starts_with("a GIF image"), "{e}");
         let jpeg = encoded(ImageFormat::Jpeg);

@@ -9,6 +9,7 @@ pub mod draco;
 mod gltf_read;
 mod gltf_write;
 pub mod image;
+mod ktx2;
 mod meshopt;
 mod obj;
 pub mod obj_parse;

@@ -87,7 +87,7 @@ codes! {
     PRIMITIVE_COMPRESSED = Warning, "decompress it to have its frames checked: `npx @gltf-transform/cli copy IN.glb OUT.glb` writes Draco meshes uncompressed";
     /// The normal texture's image could not be decoded (format, missing file).
     NORMALMAP_UNREADABLE = Warning, "store the normal map as PNG, JPEG or WebP, or check that the file exists and is whole";
-    /// The normal texture's image is in a format bumpbake does not decode (KTX2, AVIF, ...).
+    /// The normal texture's image is in a format bumpbake does not decode (AVIF, a KTX2 block format, ...).
     NORMALMAP_NOT_DECODED = Info, "check this map with a tool that decodes its format, or give the texture a PNG, JPEG or WebP source as well";
     /// Texels decode (n = 2*texel - 1) to z < 0: they point into the surface.
     NORMALMAP_Z_NEGATIVE = Error, "a tangent-space normal map has z >= 0 everywhere (blue >= 128); is this an object-space map or a packed (two-channel) map?";

@@ -311,19 +311,8 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
             let via = extension.map(|e| format!(", through {e}")).unwrap_or_default();
             let wanted_by = format!("{} (as a normal map{via})", mats.join(", "));
             let bytes = scene.image_bytes(i).map_err(|e| e.to_string());
-            let kind = bytes.as_deref().map(image::Kind::sniff).unwrap_or(image::Kind::Unknown);
-            if bytes.is_ok() && !kind.is_decoded() && kind != image::Kind::Unknown {
-                let what = match kind {
-                    image::Kind::Ktx2 => "KTX2 (Basis Universal)".to_string(),
-                    k => k.name().to_string(),
-                };
-                let f = Finding::new(
-                    Code::NORMALMAP_NOT_DECODED,
-                    1,
-                    1,
-                    "images",
-                    format!("not checked: {what} images are not decoded by bumpbake (it reads {})", image::DECODED),
-                );
+            if let Some(why) = bytes.as_deref().ok().and_then(image::not_decoded_why) {
+                let f = Finding::new(Code::NORMALMAP_NOT_DECODED, 1, 1, "images", format!("not checked: {why}"));
                 s.check(Code::NORMALMAP_NOT_DECODED, Some(f));
                 return s;
             }

@@ -299,3 +299,22 @@ pub fn grid(n: usize) -> Mesh16 {
     }
     (p.clone(), vec![[0.0, 0.0, 1.0]; p.len()], uv, idx)
 }
+
+/// One quad whose material's normal texture is `texture` (its images are the caller's).
+pub fn normal_mapped_quad(g: &mut Gltf, texture: Value) {
+    let (pos, nrm, uv, idx) = grid(1);
+    let attrs = json!({
+        "POSITION": g.floats(&pos, Some(34962)),
+        "NORMAL": g.floats(&nrm, Some(34962)),
+        "TEXCOORD_0": g.floats(&uv, Some(34962)),
+    });
+    let i = g.indices(&idx);
+    g.json["textures"] = json!([texture]);
+    let m = g.material(json!({ "normalTexture": { "index": 0 } }));
+    g.mesh(json!({ "attributes": attrs, "indices": i, "material": m }));
+}
+
+pub fn data_uri(mime: &str, bytes: &[u8]) -> String {
+    use base64::Engine as _;
+    format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(bytes))
+}

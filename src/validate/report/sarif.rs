@@ -40,7 +40,9 @@ fn description(code: Code) -> &'static str {
         }
         PRIMITIVE_NOT_CHECKED => "A primitive the checks cannot read (not triangles, compressed, no POSITION).",
         NORMALMAP_UNREADABLE => "A material's normal-texture image could not be read or decoded.",
-        NORMALMAP_NOT_DECODED => "A normal-map image in a format bumpbake does not decode (KTX2, AVIF): not checked.",
+        NORMALMAP_NOT_DECODED => {
+            "A normal-map image in a format bumpbake does not decode (AVIF, block-compressed KTX2): not checked."
+        }
         NORMALMAP_Z_NEGATIVE => "Normal-map texels decode to z < 0: they point into the surface.",
         NORMALMAP_NOT_UNIT => "Normal-map texels decode to vectors more than 10% off unit length.",
         NORMALMAP_FLAT => "Every texel of the normal map is the flat normal (0, 0, 1), to within 8-bit rounding.",

@@ -1,0 +1,85 @@
+use super::*;
+
+/// A one-level 2D KTX2 file of a plain vkFormat, uncompressed (a minimal data format descriptor).
+fn plain_file(vk: u32, type_size: u32, w: u32, h: u32, channels: usize, data: &[u8]) -> Vec<u8> {
+    let mut dfd = Vec::new();
+    let block_len = 24 + 16 * channels;
+    dfd.extend_from_slice(&((4 + block_len) as u32).to_le_bytes());
+    dfd.extend_from_slice(&0u32.to_le_bytes());
+    dfd.extend_from_slice(&2u16.to_le_bytes());
+    dfd.extend_from_slice(&(block_len as u16).to_le_bytes());
+    dfd.extend_from_slice(&[1, 1, 1, 0, 0, 0, 0, 0, (type_size as usize * channels) as u8, 0, 0, 0, 0, 0, 0, 0]);
+    for (k, id) in [0u8, 1, 2, 15].iter().take(channels).enumerate() {
+        dfd.extend_from_slice(&((k as u32 * 8 * type_size) as u16).to_le_bytes());
+        dfd.extend_from_slice(&[(8 * type_size - 1) as u8, *id, 0, 0, 0, 0]);
+        dfd.extend_from_slice(&0u32.to_le_bytes());
+        dfd.extend_from_slice(&u32::MAX.to_le_bytes());
+    }
+    let dfd_ofs = 12 + 68 + 24;
+    let level_ofs = (dfd_ofs + dfd.len()).div_ceil(16) * 16;
+    let mut f = vec![0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+    for v in [vk, type_size, w, h, 0, 0, 1, 1, 0, dfd_ofs as u32, dfd.len() as u32, 0, 0] {
+        f.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in [0u64, 0, level_ofs as u64, data.len() as u64, data.len() as u64] {
+        f.extend_from_slice(&v.to_le_bytes());
+    }
+    f.extend_from_slice(&dfd);
+    f.resize(level_ofs, 0);
+    f.extend_from_slice(data);
+    f
+}
+
+#[test]
+fn plain_texels_decode_exactly_and_two_channels_rebuild_z() {
+    let data: Vec<u8> = (0..4 * 2 * 4).map(|i| (i * 7) as u8).collect();
+    let img = decode_within(&plain_file(37, 1, 4, 2, 4, &data), &Limits::TEXTURE).unwrap();
+    assert_eq!(img.as_rgba8().unwrap().as_raw(), &data);
+    // x = y = 128 (0.0039): z is 1, stored as 255; x = 255, y = 128: z is 0, stored as 128.
+    let img = decode_within(&plain_file(16, 1, 2, 1, 2, &[128, 128, 255, 128]), &Limits::TEXTURE).unwrap();
+    assert_eq!(img.as_rgb8().unwrap().as_raw(), &[128, 128, 255, 255, 128, 128]);
+}
+
+#[test]
+fn half_floats_convert_exactly() {
+    assert_eq!(f16_to_f32(0x3C00), 1.0);
+    assert_eq!(f16_to_f32(0xC000), -2.0);
+    assert_eq!(f16_to_f32(0x0001), 2f32.powi(-24));
+    assert_eq!(f16_to_f32(0x3555), 0.333_251_95);
+    assert!(f16_to_f32(0x7C00).is_infinite() && f16_to_f32(0x7E00).is_nan());
+}
+
+#[test]
+fn sizes_are_refused_from_the_header_before_anything_is_read() {
+    // Claims 100000 x 100000 RGBA8 and holds 4 bytes: refused by size, not by its data.
+    let f = plain_file(37, 1, 100_000, 100_000, 4, &[0; 4]);
+    let e = decode_within(&f, &Limits::TEXTURE).unwrap_err();
+    assert!(e.contains("100000x100000"), "{e}");
+    let e = decode_within(&f, &Limits::file(1000)).unwrap_err();
+    assert!(e.contains("--max-pixels"), "{e}");
+}
+
+#[test]
+fn malformed_files_are_one_line_of_words() {
+    let good = plain_file(37, 1, 4, 2, 4, &[9; 32]);
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (good[..good.len() - 1].to_vec(), "ends early"),
+        (good[..60].to_vec(), "ends early"),
+        (plain_file(37, 1, 4, 2, 4, &[9; 31]), "holds 31 bytes"),
+        (plain_file(37, 2, 4, 2, 4, &[9; 32]), "typeSize"),
+        (plain_file(145, 1, 4, 4, 4, &[9; 16]), "BC1-BC7 block format, which bumpbake does not decode"),
+    ];
+    for (bytes, words) in cases {
+        let e = decode_within(&bytes, &Limits::TEXTURE).unwrap_err();
+        assert!(e.contains(words) && !e.contains('\n') && !e.contains("Err("), "{e}");
+    }
+    assert!(not_decoded(&plain_file(145, 1, 4, 4, 4, &[9; 16])).is_some());
+    assert!(not_decoded(&good).is_none() && not_decoded(&good[..60]).is_none());
+}
+
+#[test]
+fn a_basis_header_is_the_size_the_transcoder_expects() {
+    let f = basis::tests_support::empty_uastc(8, 4);
+    assert_eq!(f.len(), 77 + 23 + 2 * 16);
+    assert_eq!(&f[..2], b"sB");
+}
