@@ -169,6 +169,7 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         miss_mask: a.miss_mask.clone(),
         read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
         progress: a.io.inputs.len() == 1 && batch::progress_wanted(a.batch.progress, a.batch.quiet || a.batch.json),
+        ..Default::default()
     }))
 }
 

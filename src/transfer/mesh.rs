@@ -5,8 +5,8 @@
 //! coordinates: node transforms are not applied, the frames bumpbake writes are mesh-local too.
 
 use crate::error::{Error, Result};
-use crate::scene::to_triangle_list;
-use crate::scene::{smooth_normals, PrimRef, Primitive, ReadOptions, Scene, Slot};
+use crate::format::raw::{read_raw, RawMesh};
+use crate::scene::{smooth_vertex_normals, PrimRef, Primitive, ReadOptions, Scene, Slot};
 use glam::{DVec3, Vec3A};
 use std::path::Path;
 
@@ -28,15 +28,52 @@ pub struct Low {
     pub diagonal: f64,
 }
 
-/// HIGH: triangles (corners in the local frame) and smooth per-vertex normals.
+/// HIGH, held once: positions in the local frame, indexed triangles, unit normals. About 40
+/// bytes a triangle for a closed mesh whose normals follow its positions.
 #[derive(Debug, Default)]
 pub struct High {
-    pub corners: Vec<[Vec3A; 3]>,
-    pub normals: Vec<Vec3A>,
-    pub normal_index: Vec<[u32; 3]>,
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    /// Per triangle, indices into `normals`; `None` when those are `triangles` (one normal per
+    /// position, as most files store them).
+    pub normal_triangles: Option<Vec<[u32; 3]>>,
 }
 
-fn local(p: [f32; 3], o: DVec3) -> Vec3A {
+impl High {
+    /// Appends a mesh as read, moving its positions into the frame centred on `origin`; smooth
+    /// normals where it has none. Its arrays are taken over, not copied, when HIGH is empty.
+    pub fn append(&mut self, raw: RawMesh, origin: DVec3) {
+        let RawMesh { mut positions, mut normals, triangles, normal_triangles, .. } = raw;
+        let shared = normals.is_empty() || normal_triangles == triangles;
+        if normals.is_empty() {
+            normals = smooth_vertex_normals(&positions, &triangles);
+        }
+        positions.iter_mut().for_each(|p| *p = local(*p, origin).to_array());
+        let (base_p, base_n) = (self.positions.len() as u32, self.normals.len() as u32);
+        if shared && self.normal_triangles.is_none() && base_p == base_n {
+            if self.triangles.is_empty() {
+                self.triangles = triangles;
+            } else {
+                self.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base_p)));
+            }
+        } else {
+            let nt = self.normal_triangles.get_or_insert_with(|| self.triangles.clone());
+            let own = if shared { &triangles } else { &normal_triangles };
+            nt.extend(own.iter().map(|t| t.map(|i| i + base_n)));
+            self.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base_p)));
+        }
+        if self.positions.is_empty() {
+            self.positions = positions;
+            self.normals = normals;
+        } else {
+            self.positions.extend(positions);
+            self.normals.extend(normals);
+        }
+    }
+}
+
+pub(crate) fn local(p: [f32; 3], o: DVec3) -> Vec3A {
     let d = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) - o;
     Vec3A::new(d.x as f32, d.y as f32, d.z as f32)
 }
@@ -88,34 +125,12 @@ pub fn low(scene: &Scene, prims: &[PrimRef]) -> Result<Low> {
     Ok(out)
 }
 
-/// Every triangle primitive of the file at `path`, in document order, as per-corner positions
-/// and per-vertex normals (smooth normals where the file has none).
+/// Every triangle the file at `path` shows, appended to `into`; returns how many.
 fn read_triangles(path: &Path, read: &ReadOptions, origin: DVec3, into: &mut High) -> Result<usize> {
-    let scene = Scene::read(path, read)?;
-    let before = into.corners.len();
-    for r in scene.primitives() {
-        if !is_triangles(&scene, r) {
-            continue;
-        }
-        let p = to_triangle_list(scene.primitive(r)?);
-        let pos = p.positions();
-        let base = into.normals.len() as u32;
-        match p.attr("NORMAL") {
-            Some(n) => {
-                into.normals.extend(n.to_f32::<3>().into_iter().map(|v| Vec3A::from(v).normalize_or_zero()));
-                into.normal_index.extend(p.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
-            }
-            None => {
-                let (n, _) = smooth_normals(pos.as_flattened(), &p.indices);
-                into.normals.extend(n.into_iter().map(Vec3A::from));
-                into.normal_index.extend(
-                    (0..p.indices.len() as u32 / 3).map(|k| [base + 3 * k, base + 3 * k + 1, base + 3 * k + 2]),
-                );
-            }
-        }
-        into.corners.extend(p.indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| local(pos[t[k] as usize], origin))));
-    }
-    Ok(into.corners.len() - before)
+    let raw = read_raw(path, read)?;
+    let n = raw.triangles.len();
+    into.append(raw, origin);
+    Ok(n)
 }
 
 /// Reads every HIGH file; returns the triangles and each file's triangle count.
@@ -136,15 +151,15 @@ pub fn high(paths: &[std::path::PathBuf], read: &ReadOptions, origin: DVec3) -> 
 pub fn cage(path: &Path, read: &ReadOptions, low: &Low) -> Result<Vec<[Vec3A; 3]>> {
     let mut h = High::default();
     read_triangles(path, read, low.origin, &mut h)?;
-    if h.corners.len() != low.triangles.len() {
+    if h.triangles.len() != low.triangles.len() {
         return Err(Error::input(
             path,
             format!(
                 "the cage has {} triangles, LOW has {}; a cage must be LOW with its vertices moved (same triangles, same order)",
-                h.corners.len(),
+                h.triangles.len(),
                 low.triangles.len()
             ),
         ));
     }
-    Ok(h.corners)
+    Ok(h.triangles.iter().map(|t| t.map(|i| Vec3A::from(h.positions[i as usize]))).collect())
 }

@@ -15,6 +15,7 @@ pub mod raster;
 pub mod raycast;
 
 use crate::error::{Error, Result};
+use crate::format::raw::RawMesh;
 use crate::normalmap::{self, Convention, Depth, NormalData, NormalImage, PngSettings};
 use crate::report::Timings;
 use crate::scene::{PrimRef, ReadOptions, Scene};
@@ -51,7 +52,13 @@ pub struct Settings {
     pub read: ReadOptions,
     /// Draw a progress bar on stderr.
     pub progress: bool,
+    /// HIGH already in memory, taken by the first bake (then `highs` only names it): how the
+    /// bench bakes meshes too large to write and read at every run.
+    pub given: Option<GivenHigh>,
 }
+
+/// A mesh handed to one bake.
+pub type GivenHigh = std::sync::Arc<std::sync::Mutex<Option<RawMesh>>>;
 
 impl Default for Settings {
     fn default() -> Self {
@@ -71,6 +78,7 @@ impl Default for Settings {
             miss_mask: None,
             read: ReadOptions::default(),
             progress: false,
+            given: None,
         }
     }
 }
@@ -119,6 +127,8 @@ pub struct TransferReport {
     /// Signed distance from LOW to HIGH along the rays (scene units) over all hits.
     pub height_range: Option<[f32; 2]>,
     pub bvh_nodes: usize,
+    /// Bytes HIGH takes while rays are cast (tree, positions, triangles, normals).
+    pub high_bytes: usize,
     pub timings_ms: Timings,
 }
 
@@ -181,15 +191,25 @@ pub fn bake(scene: &Scene, prims: &[PrimRef], s: &Settings, progress: Progress) 
     if let Some(c) = &s.cage {
         low.cage = Some(t.time("cage", || mesh::cage(c, &s.read, &low))?);
     }
-    let (high, counts) = t.time("read high", || mesh::high(&s.highs, &s.read, low.origin))?;
+    let given = s.given.as_ref().and_then(|g| g.lock().ok().and_then(|mut m| m.take()));
+    let (high, counts) = match given {
+        Some(raw) => {
+            let n = raw.triangles.len();
+            let mut h = High::default();
+            t.time("read high", || h.append(raw, low.origin));
+            (h, vec![n; s.highs.len().min(1)])
+        }
+        None => t.time("read high", || mesh::high(&s.highs, &s.read, low.origin))?,
+    };
     crate::report::mem_mark("transfer read");
-    let High { corners, normals, normal_index } = high;
-    let bvh = t.time("bvh", || bvh::Bvh::build(&corners));
-    drop(corners);
+    let High { positions, triangles, normals, normal_triangles } = high;
+    let bvh = t.time("bvh", || bvh::Bvh::build(positions, triangles));
     crate::report::mem_mark("transfer bvh");
     let front = s.ray_front.unwrap_or(DEFAULT_REACH * low.diagonal);
     let back = s.ray_back.unwrap_or(DEFAULT_REACH * low.diagonal);
-    let ctx = Ctx { low: &low, bvh: &bvh, normals: &normals, normal_index: &normal_index, front, back };
+    let high_bytes = bvh.bytes() + normals.capacity() * 12 + normal_triangles.as_ref().map_or(0, |n| n.capacity() * 12);
+    let ctx =
+        Ctx { low: &low, bvh: &bvh, normals: &normals, normal_triangles: normal_triangles.as_deref(), front, back };
     let (texels, mut c) = t.time("rays", || ctx.trace(s, progress));
     crate::report::mem_mark("transfer rays");
     let (w, h) = (s.width, s.height);
@@ -210,6 +230,7 @@ pub fn bake(scene: &Scene, prims: &[PrimRef], s: &Settings, progress: Progress) 
         counts: c,
         height_range,
         bvh_nodes: bvh.nodes.len(),
+        high_bytes,
         timings_ms: t,
     };
     Ok(Baked { png, files, report })
@@ -239,8 +260,9 @@ fn check(s: &Settings) -> Result<()> {
 struct Ctx<'a> {
     low: &'a Low,
     bvh: &'a bvh::Bvh,
-    normals: &'a [Vec3A],
-    normal_index: &'a [[u32; 3]],
+    normals: &'a [[f32; 3]],
+    /// `None`: normals follow the positions' indices.
+    normal_triangles: Option<&'a [[u32; 3]]>,
     front: f64,
     back: f64,
 }
@@ -399,11 +421,12 @@ impl Ctx<'_> {
             c.missed_rays += 1;
             return flat;
         };
-        let ni = self.normal_index[hit.id as usize];
-        let hn = (self.normals[ni[0] as usize] * hit.bary[0]
-            + self.normals[ni[1] as usize] * hit.bary[1]
-            + self.normals[ni[2] as usize] * hit.bary[2])
-            .normalize_or_zero();
+        let ni = match self.normal_triangles {
+            Some(nt) => nt[hit.id as usize],
+            None => self.bvh.tris[hit.slot as usize],
+        };
+        let n = |k: usize| Vec3A::from(self.normals[ni[k] as usize]) * hit.bary[k];
+        let hn = (n(0) + n(1) + n(2)).normalize_or_zero();
         let bit = nrm.cross(tan) * sign;
         let m = Mat3A::from_cols(tan, bit, nrm);
         let det = m.determinant();
