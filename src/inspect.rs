@@ -141,13 +141,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let images = arr("images").iter().enumerate().map(|(i, img)| image_info(&scene, i, img)).collect();
     Ok(Inspection {
         file: path.to_path_buf(),
-        format: if scene.uv_v_up {
-            "obj"
-        } else if std::fs::read(path).map(|b| b.starts_with(b"glTF")).unwrap_or(false) {
-            "glb"
-        } else {
-            "gltf"
-        },
+        format: scene.source_format.name(),
         generator: scene.json.pointer("/asset/generator").and_then(|g| g.as_str()).map(String::from),
         nodes: arr("nodes").len(),
         meshes: arr("meshes").len(),

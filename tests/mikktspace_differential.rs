@@ -434,3 +434,33 @@ fn soak() {
     let total: u64 = cases.iter().sum();
     println!("soak: {total} meshes in {secs} s without a mismatch (per kind {cases:?}, seed {seed0})");
 }
+
+/// Writes the OBJ scans' reference tangents (`fixtures/spot/spot.tangents.txt`,
+/// `fixtures/blub/blub.tangents.txt`): the reference engine on primitive 0 as bumpbake's reader
+/// hands it over (UVs already turned to glTF's v down, normals as the reader makes them), `w` in
+/// glTF's convention. Rerun only when what the reader hands over changes:
+/// `cargo test --features reference --test mikktspace_differential -- --ignored write_obj_references`
+#[test]
+#[ignore]
+fn write_obj_references() {
+    use bumpbake::scene::{ReadOptions, Scene};
+    use std::fmt::Write;
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
+    for (obj, out) in
+        [("spot/spot.obj", "spot/spot.tangents.txt"), ("blub/blub_triangulated.obj", "blub/blub.tangents.txt")]
+    {
+        let scene = Scene::read(&dir.join(obj), &ReadOptions::default()).expect("fixture reads");
+        let p = scene.primitive(scene.primitives()[0]).expect("primitive 0");
+        let positions = p.positions();
+        let normals: Vec<[f32; 3]> = p.attr("NORMAL").expect("normals").to_f32();
+        let uvs: Vec<[f32; 2]> = p.attr("TEXCOORD_0").expect("UVs").to_f32();
+        let mesh = TriMesh { positions: &positions, normals: &normals, uvs: &uvs, indices: &p.indices };
+        let mut text = String::new();
+        for (c, f) in generate(&mesh, Engine::Bevy).iter().enumerate() {
+            // Corners without a reference frame (degenerate triangles) are not compared.
+            let [x, y, z, w] = f.unwrap_or([0.0, 0.0, 0.0, -1.0]);
+            writeln!(text, "{} {} {x:?} {y:?} {z:?} {}", c / 3, c % 3, bumpbake::tangent::gltf_w(w)).unwrap();
+        }
+        std::fs::write(dir.join(out), text).expect("reference written");
+    }
+}

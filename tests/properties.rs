@@ -19,8 +19,8 @@ fn coord() -> impl Strategy<Value = f32> {
     ]
 }
 
-/// Positions, optional normals, UVs, indices, and whether the UVs are OBJ-style (v up).
-type Mesh = (Vec<[f32; 3]>, Option<Vec<[f32; 3]>>, Vec<[f32; 2]>, Vec<u32>, bool);
+/// Positions, optional normals, UVs, indices.
+type Mesh = (Vec<[f32; 3]>, Option<Vec<[f32; 3]>>, Vec<[f32; 2]>, Vec<u32>);
 
 fn mesh() -> impl Strategy<Value = Mesh> {
     (1usize..24).prop_flat_map(|n| {
@@ -29,7 +29,6 @@ fn mesh() -> impl Strategy<Value = Mesh> {
             prop::option::of(prop::collection::vec([coord(), coord(), coord()], n)),
             prop::collection::vec([coord(), coord()], n),
             prop::collection::vec(0..n as u32, 3..90),
-            any::<bool>(),
         )
     })
 }
@@ -53,7 +52,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
 
     #[test]
-    fn frames_are_finite_unit_orthogonal((pos, nrm, uv, idx, v_up) in mesh()) {
+    fn frames_are_finite_unit_orthogonal((pos, nrm, uv, idx) in mesh()) {
         let idx = idx[..idx.len() / 3 * 3].to_vec();
         let mut attributes = vec![("POSITION".to_string(), Stream::from_f32("VEC3", &pos))];
         if let Some(n) = &nrm {
@@ -61,7 +60,7 @@ proptest! {
         }
         attributes.push(("TEXCOORD_0".to_string(), Stream::from_f32("VEC2", &uv)));
         let p = Primitive { attributes, targets: vec![], indices: idx.clone(), mode: 4 };
-        let (out, stats) = primitive_with_stats(p, 0, v_up, &Options::default());
+        let (out, stats) = primitive_with_stats(p, 0, &Options::default());
         prop_assert_eq!(out.indices.len(), idx.len());
         prop_assert!(stats.fallback.total() <= idx.len());
         let t: Vec<[f32; 4]> = out.attr("TANGENT").unwrap().to_f32();

@@ -78,7 +78,7 @@ fn spot_obj_matches_reference() {
     let out = d.join("spot.glb");
     // Spot's material has no normal map, so --all asks for tangents anyway.
     run_ok(&["tangents", s(&fixture("spot/spot.obj")), "-o", s(&out), "--all", "-q"]);
-    // The output's UVs are flipped to glTF (v down); the reference fed the OBJ's v-up UVs.
+    // The reader flips the UVs to glTF (v down); the reference was fed the same flipped UVs.
     assert_matches_reference(&out, "spot/spot.tangents.txt", 1e-5);
 }
 

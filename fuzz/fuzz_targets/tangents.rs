@@ -12,7 +12,6 @@ struct Mesh {
     normals: Option<Vec<[f32; 3]>>,
     uvs: Vec<[f32; 2]>,
     indices: Vec<u16>,
-    v_up: bool,
     /// Scale applied to positions, as a power of ten, to reach tiny and huge meshes.
     scale_exp: i8,
 }
@@ -55,7 +54,7 @@ fuzz_target!(|m: Mesh| {
     }
     attributes.push(("TEXCOORD_0".to_string(), Stream::from_f32("VEC2", &uv)));
     let p = Primitive { attributes, targets: vec![], indices: idx.clone(), mode: 4 };
-    let (out, stats) = primitive_with_stats(p, 0, m.v_up, &Options { bitangents: true, ..Default::default() });
+    let (out, stats) = primitive_with_stats(p, 0, &Options { bitangents: true, ..Default::default() });
     assert_eq!(stats.triangles, idx.len() / 3);
     assert_eq!(out.indices.len(), idx.len());
     let t: Vec<[f32; 4]> = out.attr("TANGENT").expect("tangents").to_f32();

@@ -48,14 +48,15 @@ pub fn material_wrap(scene: &Scene, material: usize) -> Wrap {
 pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings) -> Result<(Vec<u8>, Option<String>)> {
     let plane = normalmap::load_height(path, s.channel, s.max_pixels)?;
     let opts = Options { strength: s.strength * multiplier, filter: s.filter, wrap, invert: s.invert };
-    let warning = normalmap::flat_warning(&plane, opts.strength, multiplier)
-        .map(|w| format!("{}: {w}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()));
     let enc = EncodeOptions {
         depth: if s.sixteen_bit { normalmap::Depth::Bits16 } else { normalmap::Depth::Bits8 },
         convention: Convention::Opengl,
         alpha_height: false,
     };
     let img = normalmap::encode_normals(&plane, &opts, &enc, None);
+    let warning = normalmap::Flatness::of_image(&img)
+        .warning(&plane, opts.strength, multiplier)
+        .map(|w| format!("{}: {w}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()));
     let png = normalmap::png_bytes(&img, PngSettings::default()).map_err(|e| Error::output(path, e))?;
     Ok((png, warning))
 }

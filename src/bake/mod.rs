@@ -95,7 +95,7 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
             deps.extend(ts.highs.iter().chain(ts.cage.iter()).cloned());
             let mats: Vec<usize> = targets.iter().map(|m| m.material).collect();
             let baked = t.time("transfer", || crate::transfer::bake_materials(&scene, &mats, ts))?;
-            mats.iter().for_each(|&m| maps::replace_normal_image(&mut scene, m, &baked.png));
+            baked.maps.iter().for_each(|(m, png)| maps::replace_normal_image(&mut scene, *m, png));
             Some((baked.report, baked.files))
         }
         _ => None,
@@ -201,6 +201,7 @@ fn attach_maps(
         (Some(m), _) => vec![m],
         (None, MapSource::Scene) => (0..names.len()).collect(),
         (None, _) if names.len() == 1 => vec![0],
+        (None, MapSource::Transfer(_)) => transfer_targets(scene, job)?,
         (None, _) => {
             let t: Vec<usize> = (0..names.len()).filter(|&m| wants_bump(m)).collect();
             if t.is_empty() {
@@ -266,6 +267,33 @@ fn attach_maps(
     }
     if out.is_empty() {
         scene.notes.push("no material has a height or normal map: nothing to bake (give --height or --normal)".into());
+    }
+    Ok(out)
+}
+
+/// Without `--material`, `--from` bakes every material LOW's triangle primitives use, each into
+/// its own map, as a baker with several texture sets does. A material whose primitives have no
+/// UVs has nowhere to put a map: it is left as it is, with a note.
+fn transfer_targets(scene: &mut Scene, job: &BakeJob) -> Result<Vec<usize>> {
+    let names = material_names(scene);
+    let mut out = Vec::new();
+    for (m, name) in names.iter().enumerate() {
+        let prims = crate::transfer::material_prims(scene, m);
+        if prims.is_empty() {
+            continue;
+        }
+        if prims.iter().all(|&r| scene.prim_json(r).pointer("/attributes/TEXCOORD_0").is_some()) {
+            out.push(m);
+        } else {
+            let label = name.clone().unwrap_or_else(|| format!("material {m}"));
+            scene.notes.push(format!("{label}: its primitives have no UVs (TEXCOORD_0), so no map is baked for it"));
+        }
+    }
+    if out.is_empty() {
+        return Err(Error::input(
+            &job.mesh,
+            "no triangle primitive has UVs (TEXCOORD_0) to bake a map into; unwrap LOW (give it UVs) and bake again",
+        ));
     }
     Ok(out)
 }

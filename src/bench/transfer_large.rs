@@ -81,7 +81,8 @@ impl Torus {
                 [[a, b, c], [a, c, d]]
             })
             .collect();
-        RawMesh { positions, normals, normal_triangles: triangles.clone(), triangles, ..Default::default() }
+        let parts = vec![crate::format::raw::Part { name: "torus".into(), material: None, start: 0 }];
+        RawMesh { positions, normals, normal_triangles: triangles.clone(), triangles, parts, ..Default::default() }
     }
 }
 

@@ -6,7 +6,7 @@ use bumpbake::batch;
 use bumpbake::format::WriteOptions;
 use bumpbake::normalmap::{Channel, Convention, Filter};
 use bumpbake::scene::ReadOptions;
-use bumpbake::transfer::Settings;
+use bumpbake::transfer::{Match, Settings};
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -43,7 +43,8 @@ pub struct Args {
     /// With --from: texels of padding around UV islands.
     #[arg(long, default_value_t = 16, requires = "from")]
     pub padding: usize,
-    /// With --from: also write the map to this file (.png, .tif, .exr; --convention, --bits16).
+    /// With --from: also write the map to this file (.png, .tif, .exr; --convention, --bits16);
+    /// with several materials, one file each, named `<stem>_<material>.<ext>`.
     #[arg(long, requires = "from")]
     pub map_out: Option<PathBuf>,
     /// With --from: write the height map (signed distance LOW to HIGH, 16-bit PNG).
@@ -52,10 +53,18 @@ pub struct Args {
     /// With --from: write where rays missed HIGH (8-bit PNG, white: every ray of the texel missed).
     #[arg(long, requires = "from")]
     pub miss_mask: Option<PathBuf>,
+    /// With --from: pair LOW and HIGH parts by name (`ring_low` bakes only from `ring_high`; also
+    /// `_lo`/`_hi`, any case, before a `.001` number), or let every part see all of HIGH.
+    #[arg(long = "match", value_enum, default_value_t = Match::Auto, requires = "from")]
+    pub matching: Match,
+    /// With --from: the node to bake a LOW mesh through when several nodes show it.
+    #[arg(long, requires = "from")]
+    pub node: Option<String>,
     /// Normal map to attach (PNG/JPEG kept, WebP/TIFF/EXR stored as PNG; DirectX converted to glTF's +Y).
     #[arg(long)]
     pub normal: Option<PathBuf>,
-    /// The material that gets the map (default: those with a bump map, or the only one).
+    /// The material that gets the map (default: those with a bump map, or the only one; with
+    /// --from, every material LOW's triangles use, each its own map).
     #[arg(long)]
     pub material: Option<String>,
     /// Strength S: how tall the whole black-to-white height range stands, in texels.
@@ -168,6 +177,8 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         height_out: a.height_out.clone(),
         miss_mask: a.miss_mask.clone(),
         read: ReadOptions { allow_outside: a.io.allow_outside, ..Default::default() },
+        matching: a.matching,
+        node: a.node.clone(),
         progress: a.io.inputs.len() == 1 && batch::progress_wanted(a.batch.progress, a.batch.quiet || a.batch.json),
         ..Default::default()
     }))

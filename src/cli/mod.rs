@@ -5,11 +5,6 @@ mod out;
 
 mod bake;
 mod bench;
-mod bench_batch;
-mod bench_command;
-mod bench_normalmap;
-mod bench_tangents;
-mod bench_transfer;
 mod completions;
 mod inspect;
 mod normalmap;

@@ -2,7 +2,7 @@
 
 use super::{meshopt, uri};
 use crate::error::{Error, Result};
-use crate::scene::{as_index, ReadOptions, Scene};
+use crate::scene::{as_index, ReadOptions, Scene, SourceFormat};
 use serde_json::Value;
 use std::path::Path;
 
@@ -11,7 +11,7 @@ const GLB_BIN: u32 = 0x004E4942;
 
 pub fn read_glb(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     let (json, bin) = parse_glb(path, bytes)?;
-    build(path, json, bin.map(|r| bytes[r].to_vec()), opts)
+    build(path, json, bin.map(|r| bytes[r].to_vec()), SourceFormat::Glb, opts)
 }
 
 /// [`read_glb`] on bytes it may keep: the binary chunk becomes the buffer in place, without a
@@ -24,7 +24,7 @@ pub fn read_glb_owned(path: &Path, mut bytes: Vec<u8>, opts: &ReadOptions) -> Re
         bytes.shrink_to_fit();
         bytes
     });
-    build(path, json, bin, opts)
+    build(path, json, bin, SourceFormat::Glb, opts)
 }
 
 /// The JSON and where the binary chunk lies.
@@ -68,7 +68,7 @@ fn parse_glb(path: &Path, bytes: &[u8]) -> Result<(Value, Option<std::ops::Range
 
 pub fn read_gltf(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     let json = parse_json(path, bytes)?;
-    build(path, json, None, opts)
+    build(path, json, None, SourceFormat::Gltf, opts)
 }
 
 fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value> {
@@ -84,7 +84,13 @@ fn parse_json(path: &Path, bytes: &[u8]) -> Result<Value> {
     }
 }
 
-fn build(path: &Path, mut json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions) -> Result<Scene> {
+fn build(
+    path: &Path,
+    mut json: Value,
+    bin: Option<Vec<u8>>,
+    source_format: SourceFormat,
+    opts: &ReadOptions,
+) -> Result<Scene> {
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mut buffers = Vec::new();
     let mut deps = Vec::new();
@@ -129,7 +135,7 @@ fn build(path: &Path, mut json: Value, bin: Option<Vec<u8>>, opts: &ReadOptions)
         source: path.to_path_buf(),
         base_dir,
         allow_outside: opts.allow_outside,
-        uv_v_up: false,
+        source_format,
         notes,
         deps,
         height_maps: Vec::new(),

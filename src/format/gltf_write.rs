@@ -50,14 +50,6 @@ pub struct WriteStats {
 /// Builds every file the output consists of; the caller commits them (atomically, together).
 /// The binary data is not copied: the files borrow it from `scene`.
 pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs<'a>, WriteStats)> {
-    if scene.uv_v_up {
-        let flipped = super::obj::flip_uvs_to_gltf(scene)?;
-        return write_gltf(&flipped, out, opts).map(|(files, stats)| (files.into_owned(), stats));
-    }
-    write_gltf(scene, out, opts)
-}
-
-fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(Outputs<'a>, WriteStats)> {
     let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let glb = match ext.as_str() {
         "glb" => true,
@@ -86,11 +78,24 @@ fn write_gltf<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(
     let mut new_images = Vec::with_capacity(images.len());
     let mut pending_views: Vec<(Vec<u8>, usize)> = Vec::new();
     let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string();
+    let core = core_sources(&json);
     for (i, img) in images.iter().enumerate() {
         let mut img = img.clone();
         let u = img.get("uri").and_then(|u| u.as_str()).map(|s| s.to_string());
         let plain_file = u.as_deref().map(|u| !u.starts_with("data:")).unwrap_or(false) && !scene.own_images;
-        let place = if glb {
+        // A core texture may only name PNG or JPEG by mimeType; an image in another format there
+        // (KTX2 without KHR_texture_basisu, as some engines accept) has no mimeType the output
+        // could give it, so it stays stored the way the input stored it.
+        let as_stored = core.contains(&i) && !scene.own_images && !core_mime(scene, i);
+        let place = if as_stored {
+            if plain_file {
+                Place::CopyBeside
+            } else if u.is_some() {
+                Place::Keep
+            } else {
+                Place::Buffer
+            }
+        } else if glb {
             Place::Buffer
         } else if opts.embed {
             Place::DataUri
@@ -333,6 +338,21 @@ fn strip_png_colour_chunks(bytes: Vec<u8>) -> Vec<u8> {
         at = end;
     }
     out
+}
+
+/// Images some texture names as its core `source` (not only through an extension).
+fn core_sources(json: &Value) -> BTreeSet<usize> {
+    let textures = json.get("textures").and_then(|t| t.as_array());
+    textures.into_iter().flatten().filter_map(|t| t.get("source")?.as_u64()).map(|i| i as usize).collect()
+}
+
+/// Whether image `i` is PNG or JPEG (by its bytes), the formats a core texture may carry. An
+/// image that cannot be read is left to the path that reads it, which says why.
+fn core_mime(scene: &Scene, i: usize) -> bool {
+    match scene.image_bytes(i) {
+        Ok(b) => b.starts_with(b"\x89PNG") || b.starts_with(&[0xFF, 0xD8]),
+        Err(_) => true,
+    }
 }
 
 fn sniff_mime(bytes: &[u8], uri: &str) -> String {

@@ -1,12 +1,13 @@
 //! Reading Wavefront OBJ (+ MTL) into the glTF model.
 //!
-//! UVs are kept as the OBJ stores them (v up) while tangents are generated, which is what makes the
-//! frames identical to the reference on OBJ input; the writer flips them to glTF's v down.
+//! OBJ's UVs run v up; they are turned into glTF's v down here, once, so no stage after the
+//! reader knows the mesh came from an OBJ (MikkTSpace's sign flips with v, and the glTF `w` rule,
+//! the reference sign negated, flips it back: the frames are the same).
 
 use crate::error::{Error, Result};
 use crate::scene::normals::{flat_normals, smooth_normals, unit_or_up};
 use crate::scene::weld::weld;
-use crate::scene::{array_mut, HeightMapRef, NormalMode, PrimRef, ReadOptions, Scene, Stream};
+use crate::scene::{array_mut, HeightMapRef, NormalMode, PrimRef, Primitive, ReadOptions, Scene, SourceFormat, Stream};
 use serde_json::{json, Value};
 use std::cell::RefCell;
 use std::io::BufReader;
@@ -40,7 +41,7 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
         source: path.to_path_buf(),
         base_dir: base_dir.clone(),
         allow_outside: opts.allow_outside,
-        uv_v_up: true,
+        source_format: SourceFormat::Obj,
         notes: Vec::new(),
         deps: mtl_files.into_inner(),
         height_maps: Vec::new(),
@@ -65,7 +66,8 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
                 meshes.len() - 1
             }
         };
-        let prim = build_primitive(path, &model.mesh, opts.obj_normals, &mut scene.notes, &model.name)?;
+        let mut prim = build_primitive(path, &model.mesh, opts.obj_normals, &mut scene.notes, &model.name)?;
+        uvs_to_gltf(&mut prim);
         let mut pj = json!({ "attributes": {} });
         if let Some(m) = model.mesh.material_id.filter(|&m| m < materials.len()) {
             pj["material"] = json!(m);
@@ -311,21 +313,14 @@ pub(crate) fn classify_normal_map(img: &image::DynamicImage) -> bool {
     (grey as f64) < 0.9 * n && b > 0.6 && (r - 0.5).abs() < 0.2 && (g - 0.5).abs() < 0.2
 }
 
-/// The same scene with every TEXCOORD flipped from v up (OBJ) to v down (glTF).
-pub fn flip_uvs_to_gltf(scene: &Scene) -> Result<Scene> {
-    let mut out = scene.clone();
-    for r in scene.primitives() {
-        let mut p = scene.primitive(r)?;
-        for (name, s) in p.attributes.iter_mut() {
-            if name.starts_with("TEXCOORD_") && s.format.component_type == crate::scene::accessor::FLOAT {
-                let uv: Vec<[f32; 2]> = s.to_f32::<2>().into_iter().map(|[u, v]| [u, 1.0 - v]).collect();
-                let template = s.template.take();
-                *s = Stream::from_f32("VEC2", &uv);
-                s.template = template;
-            }
+/// Every TEXCOORD of `p` flipped from v up (OBJ) to v down (glTF), per welded vertex.
+fn uvs_to_gltf(p: &mut Primitive) {
+    for (name, s) in p.attributes.iter_mut() {
+        if name.starts_with("TEXCOORD_") && s.format.component_type == crate::scene::accessor::FLOAT {
+            let uv: Vec<[f32; 2]> = s.to_f32::<2>().into_iter().map(|[u, v]| [u, 1.0 - v]).collect();
+            let template = s.template.take();
+            *s = Stream::from_f32("VEC2", &uv);
+            s.template = template;
         }
-        out.put_primitive(r, p);
     }
-    out.uv_v_up = false;
-    Ok(out)
 }

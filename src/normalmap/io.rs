@@ -321,18 +321,21 @@ pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<
     let format = OutputFormat::from_path(&c.output)?;
     let mut t = Timings::default();
     let height = t.time("decode", || load_height(&c.input, c.channel, c.max_pixels))?;
-    let warning = super::flat_warning(&height, c.options.strength, 1.0);
+    // Judged on the texels as written, as `validate` judges them.
+    let mut flat = super::Flatness::default();
     let bytes = if format == OutputFormat::Png && c.encode.depth != Depth::Float {
-        let (bytes, filter_ms, encode_ms) =
-            png_streamed(&height, &c.options, &c.encode, c.png, progress).map_err(|m| Error::output(&c.output, m))?;
+        let (bytes, filter_ms, encode_ms) = png_streamed(&height, &c.options, &c.encode, c.png, progress, &mut flat)
+            .map_err(|m| Error::output(&c.output, m))?;
         t.stages.push(("filter".into(), filter_ms));
         t.stages.push(("encode".into(), encode_ms));
         bytes
     } else {
         let img = t.time("filter", || encode_normals(&height, &c.options, &c.encode, progress));
-        drop(height);
+        flat = super::Flatness::of_image(&img);
         t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))?
     };
+    let warning = flat.warning(&height, c.options.strength, 1.0);
+    drop(height);
     t.time("write", || crate::output::write_atomic(&c.output, &bytes))?;
     Ok((t, warning))
 }
@@ -345,6 +348,7 @@ fn png_streamed(
     enc: &EncodeOptions,
     settings: PngSettings,
     progress: Progress,
+    flat: &mut super::Flatness,
 ) -> std::result::Result<(Vec<u8>, f64, f64), String> {
     use std::io::Write;
     use std::time::Instant;
@@ -378,10 +382,12 @@ fn png_streamed(
             let mut write = || -> std::result::Result<f64, String> {
                 let t = Instant::now();
                 if sample_bytes == 2 {
+                    flat.push_u16(&done_u16, ch);
                     be.clear();
                     be.extend(done_u16.iter().flat_map(|v| v.to_be_bytes()));
                     stream.write_all(&be).map_err(one_line)?;
                 } else {
+                    flat.push_u8(&done_u8, ch);
                     stream.write_all(&done_u8).map_err(one_line)?;
                 }
                 Ok(t.elapsed().as_secs_f64() * 1e3)

@@ -14,7 +14,8 @@
 //! - [`encode_normals`]: filter + encode in one pass; [`encode_plane`] for float normals.
 //! - [`write_normal_image`], [`png_bytes`]: files; [`decode_normal_image`]: back to vectors.
 //! - [`convert_file`]: the whole `bumpbake normalmap` command.
-//! - [`flat_warning`]: whether a strength leaves a height map's normal map (nearly) flat.
+//! - [`Flatness`]: the largest tilt of a map's texels, the one rule for "(nearly) flat" that `bake`,
+//!   `normalmap` and `validate` share.
 
 mod encode;
 mod filter;
@@ -34,7 +35,7 @@ pub use io::{
     colour_words, convert_file, decode_normal_image, image_bytes, load_height, load_normal_image, open_image,
     png_bytes, write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
-pub use relief::{flat_warning, steepest_slope};
+pub use relief::{steepest_slope, Flatness, Verdict, EXACT_FLAT_DEG, NEARLY_FLAT_DEG};
 pub use rows::{unit_normal, Progress};
 
 use serde::Serialize;

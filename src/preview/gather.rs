@@ -198,8 +198,7 @@ impl Cx<'_> {
             prim.indices.truncate(prim.indices.len() / 3 * 3);
             // Exactly what `bumpbake tangents` would store, so the preview shows the tool's frames.
             let transform = need.as_ref().and_then(|n| n.transform);
-            prim =
-                crate::tangent::primitive_with_uvs(prim, uv_set, transform.as_ref(), s.uv_v_up, &Default::default()).0;
+            prim = crate::tangent::primitive_with_uvs(prim, uv_set, transform.as_ref(), &Default::default()).0;
             if has_map {
                 self.notes
                     .push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));
@@ -214,12 +213,7 @@ impl Cx<'_> {
             .map(|t| t.to_f32::<4>().into_iter().map(Vec4::from).collect());
         let uv = |k: u32| -> Vec<Vec2> {
             prim.attr(&format!("TEXCOORD_{k}"))
-                .map(|t| {
-                    t.to_f32::<2>()
-                        .into_iter()
-                        .map(|[u, v]| if s.uv_v_up { Vec2::new(u, 1.0 - v) } else { Vec2::new(u, v) })
-                        .collect()
-                })
+                .map(|t| t.to_f32::<2>().into_iter().map(Vec2::from).collect())
                 .unwrap_or_default()
         };
         let mut uvs = [uv(0), uv(1)];

@@ -40,6 +40,31 @@ pub enum NormalMode {
     Smooth,
 }
 
+/// The file format a [`Scene`] was read from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SourceFormat {
+    Obj,
+    Gltf,
+    Glb,
+}
+
+impl SourceFormat {
+    /// The name reports use: `obj`, `gltf` or `glb`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SourceFormat::Obj => "obj",
+            SourceFormat::Gltf => "gltf",
+            SourceFormat::Glb => "glb",
+        }
+    }
+
+    /// Whether the format can store tangents (OBJ cannot: its renderers always make their own).
+    pub fn stores_tangents(self) -> bool {
+        self != SourceFormat::Obj
+    }
+}
+
 /// A glTF document in memory.
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -53,8 +78,9 @@ pub struct Scene {
     pub base_dir: PathBuf,
     /// Whether relative URIs may leave `base_dir`.
     pub allow_outside: bool,
-    /// True while TEXCOORD data holds OBJ UVs (v up); the writer flips them to glTF's v down.
-    pub uv_v_up: bool,
+    /// The file format the scene was read from, for reports only: every stage sees glTF's
+    /// conventions whatever the source (the OBJ reader turns v-up UVs into glTF's v-down at load).
+    pub source_format: SourceFormat,
     /// The images were gathered by bumpbake (from an MTL), not authored as glTF: the writer stores
     /// them in the buffer and drops PNG colour-space chunks glTF does not allow.
     pub own_images: bool,

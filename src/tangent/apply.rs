@@ -119,10 +119,9 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
     // The decoded copies are all that is needed now: free the bytes they came from.
     let refs: Vec<PrimRef> = work.iter().map(|w| w.0).collect();
     scene.release_primitives(&refs);
-    let v_up = scene.uv_v_up;
     let done: Vec<(Primitive, FrameStats)> = work
         .into_par_iter()
-        .map(|(_, uvs, p)| primitive_with_uvs(p, uvs.set, uvs.transform.as_ref(), v_up, &opts.frames))
+        .map(|(_, uvs, p)| primitive_with_uvs(p, uvs.set, uvs.transform.as_ref(), &opts.frames))
         .collect();
     for (r, (p, stats)) in refs.iter().zip(done) {
         scene.put_primitive(*r, p);

@@ -47,19 +47,28 @@ pub struct FrameStats {
     pub fallback: FallbackCounts,
 }
 
-/// The primitive with MikkTSpace tangents from UV set `uv_set`.
-///
-/// `uv_v_up` says the UVs follow OBJ's convention (v up): the reference sign is kept. For glTF UVs
-/// (v down) they are fed as stored and `w` is the negated reference sign (see the conventions).
+/// The `w` glTF stores for MikkTSpace's reference sign: its negation. The reference calls a
+/// triangle orientation-preserving when its UVs wind counter-clockwise with v up; glTF's UVs run
+/// v down, which turns every winding over (docs/conventions.md). The one place this rule lives.
+pub fn gltf_w(reference_w: f32) -> f32 {
+    -reference_w
+}
+
+/// [`gltf_w`] on every frame.
+fn to_gltf_w(frames: &mut frames::Frames) {
+    frames.values.iter_mut().for_each(|t| t[3] = gltf_w(t[3]));
+}
+
+/// The primitive with MikkTSpace tangents from UV set `uv_set` (glTF UVs, fed as stored).
 /// The primitive must be a triangle list with that UV set; its old TANGENT is replaced.
-pub fn primitive_with_tangents(p: Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> Primitive {
-    primitive_with_stats(p, uv_set, uv_v_up, opts).0
+pub fn primitive_with_tangents(p: Primitive, uv_set: u32, opts: &Options) -> Primitive {
+    primitive_with_stats(p, uv_set, opts).0
 }
 
 /// [`primitive_with_tangents`], with what it did. Takes the primitive by value so that each of
 /// its streams can be freed as soon as the output's copy of it is made.
-pub fn primitive_with_stats(p: Primitive, uv_set: u32, uv_v_up: bool, opts: &Options) -> (Primitive, FrameStats) {
-    primitive_with_uvs(p, uv_set, None, uv_v_up, opts)
+pub fn primitive_with_stats(p: Primitive, uv_set: u32, opts: &Options) -> (Primitive, FrameStats) {
+    primitive_with_uvs(p, uv_set, None, opts)
 }
 
 /// [`primitive_with_stats`] for a texture read through `KHR_texture_transform`: the frames follow
@@ -68,13 +77,12 @@ pub fn primitive_with_uvs(
     p: Primitive,
     uv_set: u32,
     transform: Option<&UvTransform>,
-    uv_v_up: bool,
     opts: &Options,
 ) -> (Primitive, FrameStats) {
     let vertices_in = p.vertex_count();
     let triangles = p.indices.len() / 3;
     let generated_normals = p.attr("NORMAL").is_none();
-    let (plan, fallback) = split_plan(&p, uv_set, transform, uv_v_up, opts);
+    let (plan, fallback) = split_plan(&p, uv_set, transform, opts);
     let mut out = plan.apply(p);
     out.mode = 4;
     crate::report::mem_mark("split");
@@ -88,7 +96,6 @@ fn split_plan(
     p: &Primitive,
     uv_set: u32,
     transform: Option<&UvTransform>,
-    uv_v_up: bool,
     opts: &Options,
 ) -> (SplitPlan, FallbackCounts) {
     let uv_name = format!("TEXCOORD_{uv_set}");
@@ -125,10 +132,7 @@ fn split_plan(
     };
     drop((positions, uvs));
     crate::report::mem_mark("engine");
-    if !uv_v_up {
-        // glTF UVs run v down: the output's w is the reference's sign negated (see the conventions).
-        frames.values.iter_mut().for_each(|t| t[3] = -t[3]);
-    }
+    to_gltf_w(&mut frames);
     let fallback =
         fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
     crate::report::mem_mark("repair");
@@ -162,7 +166,7 @@ fn split_plan(
     }
     let morph = if morph::needed(p, &uv_name) {
         let base = morph::Base { tangent: &tangent, normals: &normals, generated_normals };
-        morph::deltas(p, &uv_name, &base, uv_v_up, opts.engine)
+        morph::deltas(p, &uv_name, &base, opts.engine)
     } else {
         Vec::new()
     };

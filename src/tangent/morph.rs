@@ -31,13 +31,7 @@ pub(super) struct Base<'a> {
 }
 
 /// For each target, one TANGENT delta per corner of `p`: the morphed frame minus the base frame.
-pub(super) fn deltas(
-    p: &Primitive,
-    uv_name: &str,
-    base: &Base,
-    uv_v_up: bool,
-    engine: mikk::Engine,
-) -> Vec<Vec<[f32; 3]>> {
+pub(super) fn deltas(p: &Primitive, uv_name: &str, base: &Base, engine: mikk::Engine) -> Vec<Vec<[f32; 3]>> {
     let n = p.vertex_count();
     let corners = p.indices.len();
     let pos = p.positions();
@@ -80,9 +74,7 @@ pub(super) fn deltas(
             };
             let mesh = TriMesh { positions: &positions, normals: &normals, uvs: &uvs, indices: idx };
             let mut frames = generate_with_stack(&mesh, engine);
-            if !uv_v_up {
-                frames.values.iter_mut().for_each(|t| t[3] = -t[3]);
-            }
+            super::to_gltf_w(&mut frames);
             fallback::repair(
                 &mut frames,
                 fallback::CornerNormals { normals: &normals, normal_of: idx, vertex: &p.indices },

@@ -2,8 +2,8 @@
 //!
 //! The tree depends on the triangles only, never on the thread count: every split is decided by
 //! the same binned sweep, and subtrees built on other threads are spliced in a fixed order.
-//! HIGH is held once, indexed: the tree owns the positions and the triangles' corner indices,
-//! the latter permuted into leaf order so that a leaf's triangles sit together in memory.
+//! HIGH is held once, indexed: the tree holds its triangles' corner indices (into positions that
+//! several trees can share), permuted into leaf order so that a leaf's triangles sit together.
 
 use glam::Vec3A;
 
@@ -20,7 +20,6 @@ pub struct Node {
 #[derive(Debug, Clone)]
 pub struct Bvh {
     pub nodes: Vec<Node>,
-    pub positions: Vec<[f32; 3]>,
     /// Corner indices into `positions`, in leaf order.
     pub tris: Vec<[u32; 3]>,
     /// Each leaf-order triangle's index in the input.
@@ -79,7 +78,7 @@ impl Bvh {
     /// Builds the tree over `triangles` (corner indices into `positions`, which must be in
     /// range). Every triangle is kept, degenerate ones too: the intersection test rejects them,
     /// and their ids stay aligned with the input.
-    pub fn build(positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>) -> Bvh {
+    pub fn build(positions: &[[f32; 3]], triangles: Vec<[u32; 3]>) -> Bvh {
         use rayon::prelude::*;
         let mut items: Vec<Item> = triangles
             .par_iter()
@@ -98,7 +97,7 @@ impl Bvh {
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         drop(items);
         let tris = ids.par_iter().map(|&i| triangles[i as usize]).collect();
-        Bvh { nodes, positions, tris, ids }
+        Bvh { nodes, tris, ids }
     }
 
     /// An empty tree has a root with no triangles.
@@ -108,17 +107,13 @@ impl Bvh {
 
     /// The corners of leaf-order triangle `k`.
     #[inline]
-    pub fn corners(&self, k: usize) -> [Vec3A; 3] {
-        self.tris[k].map(|i| Vec3A::from(self.positions[i as usize]))
+    pub fn corners(&self, positions: &[[f32; 3]], k: usize) -> [Vec3A; 3] {
+        self.tris[k].map(|i| Vec3A::from(positions[i as usize]))
     }
 
     /// Bytes held, for the memory figures.
     pub fn bytes(&self) -> usize {
-        use std::mem::size_of;
-        self.nodes.capacity() * size_of::<Node>()
-            + self.positions.capacity() * 12
-            + self.tris.capacity() * 12
-            + self.ids.capacity() * 4
+        self.nodes.capacity() * std::mem::size_of::<Node>() + self.tris.capacity() * 12 + self.ids.capacity() * 4
     }
 }
 
@@ -259,11 +254,11 @@ fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>) {
 pub(crate) mod tests {
     use super::*;
 
-    /// A tree over unshared corners, as a triangle soup.
-    pub(crate) fn soup(tris: &[[Vec3A; 3]]) -> Bvh {
-        let positions = tris.iter().flat_map(|t| t.map(|p| p.to_array())).collect();
+    /// A tree over unshared corners, as a triangle soup, and its positions.
+    pub(crate) fn soup(tris: &[[Vec3A; 3]]) -> (Bvh, Vec<[f32; 3]>) {
+        let positions: Vec<[f32; 3]> = tris.iter().flat_map(|t| t.map(|p| p.to_array())).collect();
         let k = tris.len() as u32;
-        Bvh::build(positions, (0..k).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect())
+        (Bvh::build(&positions, (0..k).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect()), positions)
     }
 
     fn grid_tris(n: usize) -> Vec<[Vec3A; 3]> {
@@ -282,27 +277,27 @@ pub(crate) mod tests {
     #[test]
     fn leaves_cover_every_triangle_once_and_boxes_nest() {
         let tris = grid_tris(150);
-        let bvh = soup(&tris);
+        let (bvh, pos) = soup(&tris);
         let mut seen = vec![0u32; tris.len()];
-        fn walk(b: &Bvh, i: usize, seen: &mut [u32]) -> (Vec3A, Vec3A) {
+        fn walk(b: &Bvh, pos: &[[f32; 3]], i: usize, seen: &mut [u32]) -> (Vec3A, Vec3A) {
             let n = b.nodes[i];
             let (lo, hi) = (Vec3A::from(n.min), Vec3A::from(n.max));
             let (clo, chi) = if n.n > 0 {
                 let mut a = Aabb::EMPTY;
                 for k in n.a as usize..(n.a + n.n) as usize {
                     seen[b.ids[k] as usize] += 1;
-                    b.corners(k).iter().for_each(|&p| a.grow(p));
+                    b.corners(pos, k).iter().for_each(|&p| a.grow(p));
                 }
                 (a.min, a.max)
             } else {
-                let (l0, l1) = walk(b, i + 1, seen);
-                let (r0, r1) = walk(b, n.a as usize, seen);
+                let (l0, l1) = walk(b, pos, i + 1, seen);
+                let (r0, r1) = walk(b, pos, n.a as usize, seen);
                 (l0.min(r0), l1.max(r1))
             };
             assert!(lo.cmple(clo).all() && hi.cmpge(chi).all(), "node {i} does not hold its children");
             (lo, hi)
         }
-        walk(&bvh, 0, &mut seen);
+        walk(&bvh, &pos, 0, &mut seen);
         assert!(seen.iter().all(|&s| s == 1));
     }
 
@@ -310,7 +305,7 @@ pub(crate) mod tests {
     #[test]
     fn duplicates_split_by_count() {
         let t = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
-        let bvh = soup(&vec![t; 1000]);
+        let (bvh, _) = soup(&vec![t; 1000]);
         assert!(bvh.nodes.iter().all(|n| n.n as usize <= MAX_LEAF * 2));
         assert_eq!(bvh.nodes.iter().map(|n| n.n as usize).sum::<usize>(), 1000);
     }

@@ -1,13 +1,19 @@
-//! LOW and HIGH as the baker sees them: flat arrays in a local frame centred on LOW.
+//! LOW and HIGH as the baker sees them: flat arrays in world space, moved into a local frame
+//! centred on LOW.
 //!
-//! Positions are moved into the local frame in f64 before they become f32, so a model far from
-//! the origin keeps the precision it has near it. Meshes are taken in their own (mesh-local)
-//! coordinates: node transforms are not applied, the frames bumpbake writes are mesh-local too.
+//! Every mesh is placed by its node's world transform (the whole parent chain; OBJ and PLY are at
+//! identity). Positions are moved in f64 and into the local frame before they become f32, so a
+//! model far from the origin keeps the precision it has near it. LOW's frames are the ones
+//! written into OUT as a renderer places them: normals through the normal matrix, tangents
+//! through the node's matrix (as three.js, Babylon.js and the glTF sample viewer do), each
+//! normalised per vertex, and `w` negated on a mirroring node.
 
 use crate::error::{Error, Result};
 use crate::format::raw::{read_raw, RawMesh};
-use crate::scene::{smooth_vertex_normals, PrimRef, Primitive, ReadOptions, Scene, Slot};
-use glam::{DVec3, Vec3A};
+use crate::scene::nodes::{instances, Instance};
+use crate::scene::to_triangle_list;
+use crate::scene::{smooth_vertex_normals, PrimRef, ReadOptions, Scene, Slot};
+use glam::{DVec3, Mat3, Mat4, Vec3, Vec3A};
 use std::path::Path;
 
 /// LOW after tangents: per-vertex streams of every baked primitive, appended.
@@ -15,21 +21,23 @@ use std::path::Path;
 pub struct Low {
     pub positions: Vec<Vec3A>,
     pub normals: Vec<Vec3A>,
-    /// xyz and w, as written into OUT.
+    /// xyz and w, as a renderer places them in the world.
     pub tangents: Vec<[f32; 4]>,
     /// Texel coordinates before scaling: glTF UVs (v down).
     pub uvs: Vec<[f32; 2]>,
     pub triangles: Vec<[u32; 3]>,
+    /// Per triangle, its part (index into [`Placed`] names as [`low_parts`] lists them).
+    pub tri_part: Vec<u32>,
     /// Per triangle corner, when a cage is given.
     pub cage: Option<Vec<[Vec3A; 3]>>,
-    /// The local frame's origin in mesh coordinates.
+    /// The local frame's origin in world coordinates.
     pub origin: DVec3,
-    /// Diagonal of LOW's bounding box.
+    /// Diagonal of LOW's bounding box (all baked materials).
     pub diagonal: f64,
 }
 
-/// HIGH, held once: positions in the local frame, indexed triangles, unit normals. About 40
-/// bytes a triangle for a closed mesh whose normals follow its positions.
+/// HIGH, held once: positions in the local frame, indexed triangles, unit normals (world
+/// space). About 50 bytes a triangle for a closed mesh whose normals follow its positions.
 #[derive(Debug, Default)]
 pub struct High {
     pub positions: Vec<[f32; 3]>,
@@ -42,40 +50,78 @@ pub struct High {
 
 impl High {
     /// Appends a mesh as read, moving its positions into the frame centred on `origin`; smooth
-    /// normals where it has none. Its arrays are taken over, not copied, when HIGH is empty.
-    pub fn append(&mut self, raw: RawMesh, origin: DVec3) {
-        let RawMesh { mut positions, mut normals, triangles, normal_triangles, .. } = raw;
-        let shared = normals.is_empty() || normal_triangles == triangles;
+    /// normals where it has none, per part (each part's primitive has its own vertices). Its
+    /// arrays are taken over, not copied, when HIGH is empty.
+    fn append(&mut self, raw: RawMesh, origin: DVec3) {
+        let (mut normal_triangles, mut normals) = (raw.normal_triangles, raw.normals);
+        let (mut positions, triangles) = (raw.positions, raw.triangles);
         if normals.is_empty() {
-            normals = smooth_vertex_normals(&positions, &triangles);
-        }
-        positions.iter_mut().for_each(|p| *p = local(*p, origin).to_array());
-        let (base_p, base_n) = (self.positions.len() as u32, self.normals.len() as u32);
-        if shared && self.normal_triangles.is_none() && base_p == base_n {
-            if self.triangles.is_empty() {
-                self.triangles = triangles;
-            } else {
-                self.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base_p)));
+            normal_triangles = Vec::with_capacity(triangles.len());
+            for k in 0..raw.parts.len().max(1) {
+                let r = if raw.parts.is_empty() { 0..triangles.len() } else { part_range(&raw.parts, k, triangles.len()) };
+                let tris = &triangles[r];
+                let Some(lo) = tris.iter().flatten().min().copied() else { continue };
+                let hi = tris.iter().flatten().max().copied().unwrap_or(lo);
+                let shifted: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|i| i - lo)).collect();
+                let b = normals.len() as u32;
+                normals.extend(smooth_vertex_normals(&positions[lo as usize..=hi as usize], &shifted));
+                normal_triangles.extend(shifted.iter().map(|t| t.map(|i| i + b)));
             }
         } else {
+            normals.iter_mut().for_each(|v| *v = Vec3A::from(*v).normalize_or_zero().to_array());
+        }
+        let shared = normal_triangles == triangles;
+        positions.iter_mut().for_each(|p| *p = local(dvec(*p), origin).to_array());
+        let (base_p, base_n) = (self.positions.len() as u32, self.normals.len() as u32);
+        if shared && self.normal_triangles.is_none() && base_p == base_n {
+            drop(normal_triangles);
+        } else {
             let nt = self.normal_triangles.get_or_insert_with(|| self.triangles.clone());
-            let own = if shared { &triangles } else { &normal_triangles };
-            nt.extend(own.iter().map(|t| t.map(|i| i + base_n)));
-            self.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base_p)));
+            nt.extend(normal_triangles.iter().map(|t| t.map(|i| i + base_n)));
         }
         if self.positions.is_empty() {
+            self.triangles = triangles;
             self.positions = positions;
             self.normals = normals;
         } else {
+            self.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base_p)));
             self.positions.extend(positions);
             self.normals.extend(normals);
         }
     }
 }
 
-pub(crate) fn local(p: [f32; 3], o: DVec3) -> Vec3A {
-    let d = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) - o;
+fn part_range(parts: &[crate::format::raw::Part], k: usize, n: usize) -> std::ops::Range<usize> {
+    let end = parts.get(k + 1).map_or(n, |p| p.start as usize);
+    parts[k].start as usize..end
+}
+
+/// A named run of HIGH triangles, from one file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HighPart {
+    pub name: String,
+    pub file: usize,
+    pub start: u32,
+    pub end: u32,
+}
+
+/// A LOW primitive where the scene shows it.
+#[derive(Debug, Clone)]
+pub struct Placed {
+    pub prim: PrimRef,
+    /// `None` at identity (kept bit for bit).
+    pub world: Option<Mat4>,
+    /// The part: the node's name, else the mesh's.
+    pub part: String,
+}
+
+fn local(p: DVec3, o: DVec3) -> Vec3A {
+    let d = p - o;
     Vec3A::new(d.x as f32, d.y as f32, d.z as f32)
+}
+
+fn dvec(p: [f32; 3]) -> DVec3 {
+    DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
 pub fn is_triangles(scene: &Scene, r: PrimRef) -> bool {
@@ -84,13 +130,109 @@ pub fn is_triangles(scene: &Scene, r: PrimRef) -> bool {
         && pj.pointer("/attributes/POSITION").is_some()
 }
 
-/// Gathers the primitives `prims` of LOW (which now carry tangents).
-pub fn low(scene: &Scene, prims: &[PrimRef]) -> Result<Low> {
-    let mut out = Low::default();
-    let mut parts: Vec<(Primitive, u32)> = Vec::new();
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    let mats = scene.materials();
+fn node_name(scene: &Scene, n: usize) -> String {
+    scene.json["nodes"][n].get("name").and_then(|s| s.as_str()).map_or_else(|| format!("node {n}"), str::to_string)
+}
+
+fn mesh_name(scene: &Scene, m: usize) -> String {
+    scene.json["meshes"][m].get("name").and_then(|s| s.as_str()).map_or_else(|| format!("mesh {m}"), str::to_string)
+}
+
+/// Where the primitives `prims` are shown. A mesh shown by two nodes has one UV layout in two
+/// places and cannot be baked twice into one map: it is refused unless `node` names one of them.
+pub fn place(scene: &Scene, prims: &[PrimRef], node: Option<&str>) -> Result<Vec<Placed>> {
+    let all = instances(scene);
+    if let Some(want) = node {
+        let names: Vec<String> = all.iter().filter_map(|i| i.node).map(|n| node_name(scene, n)).collect();
+        if !names.iter().any(|n| n == want) {
+            return Err(scene.err(format!(
+                "--node {want}: no node of that name shows a mesh (nodes: {})",
+                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+            )));
+        }
+    }
+    let mut out = Vec::new();
     for &r in prims {
+        let shown: Vec<&Instance> = all.iter().filter(|i| i.mesh == r.mesh).collect();
+        let inst = match shown.as_slice() {
+            [] => None,
+            [one] => Some(**one),
+            many => {
+                let names: Vec<String> =
+                    many.iter().map(|i| i.node.map_or("(root)".into(), |n| node_name(scene, n))).collect();
+                match node.and_then(|w| many.iter().find(|i| i.node.is_some_and(|n| node_name(scene, n) == w))) {
+                    Some(i) => Some(**i),
+                    None => {
+                        return Err(scene.err(format!(
+                            "LOW mesh '{}' is shown by nodes '{}' (one UV layout in {} places, one map); bake one of them with --node {}",
+                            mesh_name(scene, r.mesh),
+                            names.join("' and '"),
+                            names.len(),
+                            names[0]
+                        )))
+                    }
+                }
+            }
+        };
+        let part = inst.and_then(|i| i.node).and_then(|n| scene.json["nodes"][n].get("name")).and_then(|s| s.as_str());
+        out.push(Placed {
+            prim: r,
+            world: inst.map(|i| i.world).filter(|w| *w != Mat4::IDENTITY),
+            part: part.map_or_else(|| mesh_name(scene, r.mesh), str::to_string),
+        });
+    }
+    Ok(out)
+}
+
+/// LOW's part names, in order of first appearance in `placed`, and each primitive's part.
+pub fn low_parts(placed: &[Placed]) -> (Vec<String>, Vec<u32>) {
+    let mut names: Vec<String> = Vec::new();
+    let idx = placed
+        .iter()
+        .map(|p| match names.iter().position(|n| *n == p.part) {
+            Some(i) => i as u32,
+            None => {
+                names.push(p.part.clone());
+                names.len() as u32 - 1
+            }
+        })
+        .collect();
+    (names, idx)
+}
+
+fn world_positions(scene: &Scene, p: &Placed) -> Result<Vec<DVec3>> {
+    let pos = scene.primitive(p.prim)?.positions();
+    Ok(match p.world {
+        None => pos.into_iter().map(dvec).collect(),
+        Some(m) => {
+            let m = m.as_dmat4();
+            pos.into_iter().map(|q| m.transform_point3(dvec(q))).collect()
+        }
+    })
+}
+
+/// The local frame of LOW's primitives `placed`: the centre and diagonal of their world bounds.
+pub fn frame(scene: &Scene, placed: &[Placed]) -> Result<(DVec3, f64)> {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in placed {
+        for q in world_positions(scene, p)? {
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    Ok(((lo + hi) * 0.5, (hi - lo).length()))
+}
+
+/// Gathers LOW's primitives `placed` (which now carry tangents); `part[k]` is the part of
+/// `placed[k]`.
+pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagonal: f64) -> Result<Low> {
+    let mut out = Low { origin, diagonal, ..Default::default() };
+    let mats = scene.materials();
+    if placed.is_empty() {
+        return Err(scene.err("no triangle primitive to bake onto (the material has no mesh)"));
+    }
+    for (pl, &part) in placed.iter().zip(part) {
+        let r = pl.prim;
         let set = mats.default_of(scene, r).and_then(|m| m.texture(Slot::Normal)).map_or(0, |t| t.tex_coord);
         let p = scene.primitive(r)?;
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
@@ -101,65 +243,98 @@ pub fn low(scene: &Scene, prims: &[PrimRef]) -> Result<Low> {
                 )));
             }
         }
-        for q in p.positions() {
-            let q = DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64);
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
-        parts.push((p, set));
-    }
-    if parts.is_empty() {
-        return Err(scene.err("no triangle primitive to bake onto (the material has no mesh)"));
-    }
-    out.origin = (lo + hi) * 0.5;
-    out.diagonal = (hi - lo).length();
-    for (p, set) in parts {
         let base = out.positions.len() as u32;
-        out.positions.extend(p.positions().into_iter().map(|q| local(q, out.origin)));
-        out.normals.extend(p.attr("NORMAL").map(|s| s.to_f32::<3>()).unwrap_or_default().into_iter().map(Vec3A::from));
-        out.tangents.extend(p.attr("TANGENT").map(|s| s.to_f32::<4>()).unwrap_or_default());
+        out.positions.extend(world_positions(scene, pl)?.into_iter().map(|q| local(q, origin)));
+        let normals: Vec<[f32; 3]> = p.attr("NORMAL").map(|s| s.to_f32::<3>()).unwrap_or_default();
+        let tangents: Vec<[f32; 4]> = p.attr("TANGENT").map(|s| s.to_f32::<4>()).unwrap_or_default();
+        match pl.world {
+            None => {
+                out.normals.extend(normals.into_iter().map(Vec3A::from));
+                out.tangents.extend(tangents);
+            }
+            Some(m) => {
+                let m3 = Mat3::from_mat4(m);
+                let nm = m3.inverse().transpose();
+                let sign = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
+                out.normals.extend(normals.into_iter().map(|n| Vec3A::from(nm * Vec3::from(n)).normalize_or_zero()));
+                out.tangents.extend(tangents.into_iter().map(|t| {
+                    let v = (m3 * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                    [v.x, v.y, v.z, t[3] * sign]
+                }));
+            }
+        }
         let uvs: Vec<[f32; 2]> = p.attr(&format!("TEXCOORD_{set}")).map(|s| s.to_f32()).unwrap_or_default();
-        out.uvs.extend(uvs.into_iter().map(|[u, v]| if scene.uv_v_up { [u, 1.0 - v] } else { [u, v] }));
+        out.uvs.extend(uvs);
         out.triangles.extend(p.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
+        out.tri_part.resize(out.triangles.len(), part);
     }
     Ok(out)
 }
 
-/// Every triangle the file at `path` shows, appended to `into`; returns how many.
-fn read_triangles(path: &Path, read: &ReadOptions, origin: DVec3, into: &mut High) -> Result<usize> {
-    let raw = read_raw(path, read)?;
-    let n = raw.triangles.len();
-    into.append(raw, origin);
-    Ok(n)
-}
-
-/// Reads every HIGH file; returns the triangles and each file's triangle count.
-pub fn high(paths: &[std::path::PathBuf], read: &ReadOptions, origin: DVec3) -> Result<(High, Vec<usize>)> {
+/// Reads every HIGH file in world space (`given`, when there is one, stands for the first);
+/// returns the triangles, each file's triangle count and the named parts (consecutive runs with
+/// one name).
+pub fn high(
+    paths: &[std::path::PathBuf],
+    read: &ReadOptions,
+    origin: DVec3,
+    mut given: Option<RawMesh>,
+) -> Result<(High, Vec<usize>, Vec<HighPart>)> {
     let mut h = High::default();
     let mut counts = Vec::new();
-    for p in paths {
-        let n = read_triangles(p, read, origin, &mut h)?;
-        if n == 0 {
-            return Err(Error::input(p, "has no triangles to bake from (HIGH must be a triangle mesh)"));
+    let mut parts: Vec<HighPart> = Vec::new();
+    for (f, path) in paths.iter().enumerate() {
+        let raw = match given.take() {
+            Some(m) => m,
+            None => read_raw(path, read)?,
+        };
+        if raw.triangles.is_empty() {
+            return Err(Error::input(path, "has no triangles to bake from (HIGH must be a triangle mesh)"));
         }
-        counts.push(n);
+        let base_tri = h.triangles.len() as u32;
+        for (k, p) in raw.parts.iter().enumerate() {
+            let r = raw.part_range(k);
+            let (start, end) = (base_tri + r.start as u32, base_tri + r.end as u32);
+            match parts.last_mut() {
+                Some(last) if last.file == f && last.name == p.name && last.end == start => last.end = end,
+                _ => parts.push(HighPart { name: p.name.clone(), file: f, start, end }),
+            }
+        }
+        counts.push(raw.triangles.len());
+        h.append(raw, origin);
     }
-    Ok((h, counts))
+    Ok((h, counts, parts))
 }
 
-/// The cage: a mesh with LOW's topology, its corners matched to LOW's triangles in order.
-pub fn cage(path: &Path, read: &ReadOptions, low: &Low) -> Result<Vec<[Vec3A; 3]>> {
-    let mut h = High::default();
-    read_triangles(path, read, low.origin, &mut h)?;
-    if h.triangles.len() != low.triangles.len() {
+/// The cage: a mesh with LOW's topology, its corners matched to LOW's triangles in order. When
+/// the cage file has LOW's primitives (LOW with its vertices moved), the primitives baked now are
+/// taken from it; otherwise all of its triangles, in order.
+pub fn cage(
+    path: &Path,
+    read: &ReadOptions,
+    node: Option<&str>,
+    placed: &[Placed],
+    low: &Low,
+) -> Result<Vec<[Vec3A; 3]>> {
+    let scene = Scene::read(path, read)?;
+    let prims: Vec<PrimRef> = scene.primitives().into_iter().filter(|&r| is_triangles(&scene, r)).collect();
+    let same = placed.iter().all(|p| prims.contains(&p.prim));
+    let chosen: Vec<PrimRef> = if same { placed.iter().map(|p| p.prim).collect() } else { prims };
+    let mut corners = Vec::new();
+    for pl in place(&scene, &chosen, node)? {
+        let pos = world_positions(&scene, &pl)?;
+        let p = to_triangle_list(scene.primitive(pl.prim)?);
+        corners.extend(p.indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| local(pos[t[k] as usize], low.origin))));
+    }
+    if corners.len() != low.triangles.len() {
         return Err(Error::input(
             path,
             format!(
                 "the cage has {} triangles, LOW has {}; a cage must be LOW with its vertices moved (same triangles, same order)",
-                h.triangles.len(),
+                corners.len(),
                 low.triangles.len()
             ),
         ));
     }
-    Ok(h.triangles.iter().map(|t| t.map(|i| Vec3A::from(h.positions[i as usize]))).collect())
+    Ok(corners)
 }

@@ -11,8 +11,10 @@
 pub mod bvh;
 pub mod mesh;
 pub mod pad;
+pub mod parts;
 pub mod raster;
 pub mod raycast;
+pub mod report;
 
 use crate::error::{Error, Result};
 use crate::format::raw::RawMesh;
@@ -20,10 +22,13 @@ use crate::normalmap::{self, Convention, Depth, NormalData, NormalImage, PngSett
 use crate::report::Timings;
 use crate::scene::{PrimRef, ReadOptions, Scene};
 use glam::{Mat3A, Vec3A};
-use mesh::{High, Low};
+use mesh::{High, Low, Placed};
+pub use parts::Match;
 use raster::{Edges, UvTri};
 use rayon::prelude::*;
-use std::path::PathBuf;
+pub use report::{Counts, TransferReport};
+use report::{HighFile, HighPartReport, MaterialReport, Pair, PartStats};
+use std::path::{Path, PathBuf};
 
 /// Default ray reach on each side of LOW, as a fraction of LOW's bounding-box diagonal.
 pub const DEFAULT_REACH: f64 = 0.05;
@@ -52,8 +57,12 @@ pub struct Settings {
     pub read: ReadOptions,
     /// Draw a progress bar on stderr.
     pub progress: bool,
-    /// HIGH already in memory, taken by the first bake (then `highs` only names it): how the
-    /// bench bakes meshes too large to write and read at every run.
+    /// How LOW parts find their HIGH parts.
+    pub matching: Match,
+    /// The node to bake a LOW mesh shown by several nodes through.
+    pub node: Option<String>,
+    /// HIGH already in memory, standing for the first of `highs` and taken by the first bake:
+    /// how the bench bakes meshes too large to write and read at every run.
     pub given: Option<GivenHigh>,
 }
 
@@ -78,63 +87,17 @@ impl Default for Settings {
             miss_mask: None,
             read: ReadOptions::default(),
             progress: false,
+            matching: Match::Auto,
+            node: None,
             given: None,
         }
     }
 }
 
-/// Counts of what happened, per texel unless named otherwise.
-#[derive(Debug, Clone, Default, serde::Serialize, PartialEq)]
-pub struct Counts {
-    /// Texels with a sample inside a UV triangle.
-    pub covered: usize,
-    /// Texels just outside an island, filled by continuing its border triangle.
-    pub extended: usize,
-    pub padded: usize,
-    /// Texels left flat: no triangle and no island within the padding.
-    pub uncovered: usize,
-    pub rays: usize,
-    /// Rays that met nothing within reach: their samples are flat.
-    pub missed_rays: usize,
-    pub texels_with_misses: usize,
-    /// Samples inside two or more UV triangles (the lowest-numbered triangle is baked).
-    pub overlapping_samples: usize,
-    /// LOW triangles without UV area (nothing to bake them into).
-    pub zero_uv_triangles: usize,
-    /// Hits whose normal faces away from LOW's side (tangent-space z < 0): clamped to z = 0.
-    pub clamped_below: usize,
-    /// Samples where LOW's frame is degenerate (zero normal or tangent): flat.
-    pub degenerate_frames: usize,
-}
-
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct HighFile {
-    pub file: PathBuf,
-    pub triangles: usize,
-}
-
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct TransferReport {
-    pub high: Vec<HighFile>,
-    pub cage: Option<PathBuf>,
-    pub low_triangles: usize,
-    pub width: usize,
-    pub height: usize,
-    pub samples_per_texel: usize,
-    pub ray_front: f64,
-    pub ray_back: f64,
-    pub counts: Counts,
-    /// Signed distance from LOW to HIGH along the rays (scene units) over all hits.
-    pub height_range: Option<[f32; 2]>,
-    pub bvh_nodes: usize,
-    /// Bytes HIGH takes while rays are cast (tree, positions, triangles, normals).
-    pub high_bytes: usize,
-    pub timings_ms: Timings,
-}
-
-/// What the bake made: the map (glTF convention, PNG) and any extra files asked for.
+/// What the bake made: one map per material (glTF convention, PNG) and any extra files asked for.
 pub struct Baked {
-    pub png: Vec<u8>,
+    /// `(material, PNG)`, in the order the materials were given.
+    pub maps: Vec<(usize, Vec<u8>)>,
     pub files: Vec<(PathBuf, Vec<u8>)>,
     pub report: TransferReport,
 }
@@ -152,21 +115,15 @@ struct Texel {
     missed: u16,
     height: f32,
     hits: u16,
+    /// The LOW part of the texel's first sample.
+    part: u32,
 }
 
-/// Bakes HIGH into every triangle primitive of LOW whose material is one of `materials`, with
-/// a progress bar when `s.progress` asks for one.
+/// Bakes HIGH into LOW once per material in `materials` (each its own map, over the triangle
+/// primitives that use it), with a progress bar when `s.progress` asks for one.
 pub fn bake_materials(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
-    let prims: Vec<PrimRef> = scene
-        .primitives()
-        .into_iter()
-        .filter(|&r| {
-            let mat = scene.prim_json(r).get("material").and_then(|m| m.as_u64());
-            mat.map(|m| materials.contains(&(m as usize))).unwrap_or(false) && mesh::is_triangles(scene, r)
-        })
-        .collect();
     let bar = if s.progress {
-        let b = indicatif::ProgressBar::new(s.height as u64);
+        let b = indicatif::ProgressBar::new((s.height * materials.len().max(1)) as u64);
         b.set_style(
             indicatif::ProgressStyle::with_template("bake --from [{bar:40}] {pos}/{len} rows ({elapsed})")
                 .expect("valid template")
@@ -176,64 +133,226 @@ pub fn bake_materials(scene: &Scene, materials: &[usize], s: &Settings) -> Resul
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let tick = |done: usize, all: usize| bar.set_position((done * s.height / all.max(1)) as u64);
-    let r = bake(scene, &prims, s, Some(&tick));
+    let rows = s.height * materials.len().max(1);
+    let tick = |done: usize, all: usize| bar.set_position((done * rows / all.max(1)) as u64);
+    let r = bake(scene, materials, s, Some(&tick));
     bar.finish_and_clear();
     r
 }
 
-/// Bakes HIGH into LOW's primitives `prims` (which must carry tangents already).
-pub fn bake(scene: &Scene, prims: &[PrimRef], s: &Settings, progress: Progress) -> Result<Baked> {
+/// The triangle primitives of LOW that use material `m`.
+pub fn material_prims(scene: &Scene, m: usize) -> Vec<PrimRef> {
+    scene
+        .primitives()
+        .into_iter()
+        .filter(|&r| {
+            scene.prim_json(r).get("material").and_then(|x| x.as_u64()) == Some(m as u64)
+                && mesh::is_triangles(scene, r)
+        })
+        .collect()
+}
+
+/// A material's name as it can stand in a file name: letters, digits, `-` and `_`.
+pub fn file_label(name: Option<&str>, m: usize) -> String {
+    let clean: String =
+        name.unwrap_or("").chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    if clean.trim_matches('_').is_empty() {
+        format!("material{m}")
+    } else {
+        clean
+    }
+}
+
+/// `dir/stem.ext` as `dir/stem_label.ext`.
+fn labelled(p: &Path, label: &str) -> PathBuf {
+    let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = match p.extension() {
+        Some(e) => format!("{stem}_{label}.{}", e.to_string_lossy()),
+        None => format!("{stem}_{label}"),
+    };
+    p.with_file_name(name)
+}
+
+/// HIGH's triangles grouped for the rays of each LOW part: one BVH per set of HIGH parts, all
+/// over HIGH's one array of positions.
+struct Sets {
+    positions: Vec<[f32; 3]>,
+    bvhs: Vec<bvh::Bvh>,
+    /// Per set, the HIGH triangle of each BVH id (`None`: the ids are HIGH's own).
+    ids: Vec<Option<Vec<u32>>>,
+}
+
+fn build_sets(
+    positions: Vec<[f32; 3]>,
+    mut triangles: Vec<[u32; 3]>,
+    parts: &[mesh::HighPart],
+    sets: &[Vec<usize>],
+) -> Sets {
+    let mut bvhs: Vec<Option<bvh::Bvh>> = sets.iter().map(|_| None).collect();
+    let mut ids = Vec::new();
+    for (k, set) in sets.iter().enumerate() {
+        if set.len() == parts.len() {
+            ids.push(None);
+            continue;
+        }
+        let tris: Vec<u32> = set.iter().flat_map(|&k| parts[k].start..parts[k].end).collect();
+        let sub: Vec<[u32; 3]> = tris.iter().map(|&t| triangles[t as usize]).collect();
+        bvhs[k] = Some(bvh::Bvh::build(&positions, sub));
+        ids.push(Some(tris));
+    }
+    // Every HIGH part: the tree takes HIGH's triangles over (permuted into leaf order), no copy.
+    for (k, set) in sets.iter().enumerate() {
+        if set.len() == parts.len() {
+            bvhs[k] = Some(bvh::Bvh::build(&positions, std::mem::take(&mut triangles)));
+        }
+    }
+    Sets { positions, bvhs: bvhs.into_iter().map(|b| b.expect("every set built")).collect(), ids }
+}
+
+/// Bakes HIGH into LOW: one map per material in `materials`, over the triangle primitives that
+/// use it (which must carry tangents already). HIGH is read and its trees built once.
+pub fn bake(scene: &Scene, materials: &[usize], s: &Settings, progress: Progress) -> Result<Baked> {
     check(s)?;
     let mut t = Timings::default();
-    let low = t.time("low", || mesh::low(scene, prims))?;
-    let mut low = low;
-    if let Some(c) = &s.cage {
-        low.cage = Some(t.time("cage", || mesh::cage(c, &s.read, &low))?);
+    let per_mat: Vec<Vec<PrimRef>> = materials.iter().map(|&m| material_prims(scene, m)).collect();
+    let all: Vec<PrimRef> = per_mat.iter().flatten().copied().collect();
+    let placed = t.time("low", || mesh::place(scene, &all, s.node.as_deref()))?;
+    if placed.is_empty() {
+        return Err(scene.err("no triangle primitive to bake onto (the material has no mesh)"));
     }
+    let (low_names, low_part) = mesh::low_parts(&placed);
+    let (origin, diagonal) = mesh::frame(scene, &placed)?;
     let given = s.given.as_ref().and_then(|g| g.lock().ok().and_then(|mut m| m.take()));
-    let (high, counts) = match given {
-        Some(raw) => {
-            let n = raw.triangles.len();
-            let mut h = High::default();
-            t.time("read high", || h.append(raw, low.origin));
-            (h, vec![n; s.highs.len().min(1)])
-        }
-        None => t.time("read high", || mesh::high(&s.highs, &s.read, low.origin))?,
-    };
+    let (high, counts, high_parts) = t.time("read high", || mesh::high(&s.highs, &s.read, origin, given))?;
     crate::report::mem_mark("transfer read");
+    let high_names: Vec<String> = high_parts.iter().map(|p| p.name.clone()).collect();
+    let groups = parts::group(&low_names, &high_names, s.matching);
     let High { positions, triangles, normals, normal_triangles } = high;
-    let bvh = t.time("bvh", || bvh::Bvh::build(positions, triangles));
+    let sets = t.time("bvh", || build_sets(positions, triangles, &high_parts, &groups.sets));
     crate::report::mem_mark("transfer bvh");
-    let front = s.ray_front.unwrap_or(DEFAULT_REACH * low.diagonal);
-    let back = s.ray_back.unwrap_or(DEFAULT_REACH * low.diagonal);
-    let high_bytes = bvh.bytes() + normals.capacity() * 12 + normal_triangles.as_ref().map_or(0, |n| n.capacity() * 12);
-    let ctx =
-        Ctx { low: &low, bvh: &bvh, normals: &normals, normal_triangles: normal_triangles.as_deref(), front, back };
-    let (texels, mut c) = t.time("rays", || ctx.trace(s, progress));
-    crate::report::mem_mark("transfer rays");
-    let (w, h) = (s.width, s.height);
-    let mut n: Vec<[f32; 3]> = texels.iter().map(|x| x.normal).collect();
-    let mut filled: Vec<bool> = texels.iter().map(|x| x.state > 0).collect();
-    c.padded = t.time("pad", || pad::pad(w, h, &mut n, &mut filled, s.padding));
-    c.uncovered = filled.iter().filter(|&&f| !f).count();
-    let (png, files, height_range) = t.time("encode", || encode(s, &texels, &n))?;
+    let high_bytes = sets.positions.capacity() * 12
+        + sets.bvhs.iter().map(|b| b.bytes()).sum::<usize>()
+        + sets.ids.iter().flatten().map(|v| v.capacity() * 4).sum::<usize>()
+        + normals.capacity() * 12
+        + normal_triangles.as_ref().map_or(0, |n| n.capacity() * 12);
+    let front = s.ray_front.unwrap_or(DEFAULT_REACH * diagonal);
+    let back = s.ray_back.unwrap_or(DEFAULT_REACH * diagonal);
+    let labels = unique_labels(scene, materials);
+    let mut maps = Vec::new();
+    let mut files = Vec::new();
+    let mut mats = Vec::new();
+    let mut offset = 0;
+    let n_maps = materials.len();
+    for (k, &m) in materials.iter().enumerate() {
+        let pick: Vec<(Placed, u32)> =
+            placed.iter().zip(&low_part).skip(offset).take(per_mat[k].len()).map(|(p, &i)| (p.clone(), i)).collect();
+        offset += per_mat[k].len();
+        let (pl, part): (Vec<Placed>, Vec<u32>) = pick.into_iter().unzip();
+        let mut low = t.time("low", || mesh::low(scene, &pl, &part, origin, diagonal))?;
+        if let Some(c) = &s.cage {
+            low.cage = Some(t.time("cage", || mesh::cage(c, &s.read, s.node.as_deref(), &pl, &low))?);
+        }
+        let ctx = Ctx {
+            low: &low,
+            sets: &sets,
+            low_set: &groups.low_set,
+            parts: low_names.len(),
+            normals: &normals,
+            normal_triangles: normal_triangles.as_deref(),
+            front,
+            back,
+        };
+        let shifted = |done: usize, all: usize| {
+            if let Some(p) = progress {
+                p(k * all + done, all * n_maps);
+            }
+        };
+        let (texels, mut c, mut part_stats) = t.time("rays", || ctx.trace(s, Some(&shifted)));
+        crate::report::mem_mark("transfer rays");
+        let (w, h) = (s.width, s.height);
+        let mut n: Vec<[f32; 3]> = texels.iter().map(|x| x.normal).collect();
+        let mut filled: Vec<bool> = texels.iter().map(|x| x.state > 0).collect();
+        c.padded = t.time("pad", || pad::pad(w, h, &mut n, &mut filled, s.padding));
+        c.uncovered = filled.iter().filter(|&&f| !f).count();
+        let mut sk = s.clone();
+        if n_maps > 1 {
+            for f in [&mut sk.map_out, &mut sk.height_out, &mut sk.miss_mask].into_iter().flatten() {
+                *f = labelled(f, &labels[k]);
+            }
+        }
+        let (png, extra, height_range) = t.time("encode", || encode(&sk, &texels, &n))?;
+        for (i, st) in part_stats.iter_mut().enumerate() {
+            st.name = low_names[i].clone();
+            st.triangles = low.tri_part.iter().filter(|&&p| p as usize == i).count();
+        }
+        let names = scene.materials();
+        mats.push(MaterialReport {
+            material: m,
+            name: names.get(m).and_then(|x| x.name.clone()),
+            files: extra.iter().map(|(p, _)| p.clone()).collect(),
+            low_triangles: low.triangles.len(),
+            counts: c,
+            height_range,
+            parts: part_stats.into_iter().filter(|p| p.triangles > 0).collect(),
+        });
+        maps.push((m, png));
+        files.extend(extra);
+    }
+    let mut counts_all = Counts::default();
+    mats.iter().for_each(|m| counts_all.add(&m.counts));
+    let height_range = mats.iter().filter_map(|m| m.height_range).reduce(|a, b| [a[0].min(b[0]), a[1].max(b[1])]);
+    let rest = groups.sets.len() - 1;
     let report = TransferReport {
         high: s.highs.iter().zip(counts).map(|(f, n)| HighFile { file: f.clone(), triangles: n }).collect(),
         cage: s.cage.clone(),
-        low_triangles: low.triangles.len(),
-        width: w,
-        height: h,
+        low_triangles: mats.iter().map(|m| m.low_triangles).sum(),
+        width: s.width,
+        height: s.height,
         samples_per_texel: s.samples * s.samples,
         ray_front: front,
         ray_back: back,
-        counts: c,
+        counts: counts_all,
         height_range,
-        bvh_nodes: bvh.nodes.len(),
+        bvh_nodes: sets.bvhs.iter().map(|b| b.nodes.len()).sum(),
         high_bytes,
+        matching: if s.matching == Match::Auto { "auto" } else { "none" }.to_string(),
+        pairs: groups
+            .pairs
+            .iter()
+            .map(|(l, h)| Pair {
+                low: l.iter().map(|&i| low_names[i].clone()).collect(),
+                high: h.iter().map(|&i| high_names[i].clone()).collect(),
+            })
+            .collect(),
+        unmatched_low: (0..low_names.len())
+            .filter(|&i| groups.low_set[i] == rest)
+            .map(|i| low_names[i].clone())
+            .collect(),
+        unmatched_high: groups.sets[rest].iter().map(|&i| high_names[i].clone()).collect(),
+        high_parts: high_parts
+            .iter()
+            .map(|p| HighPartReport {
+                name: p.name.clone(),
+                file: s.highs[p.file].clone(),
+                triangles: (p.end - p.start) as usize,
+            })
+            .collect(),
+        materials: mats,
         timings_ms: t,
     };
-    Ok(Baked { png, files, report })
+    Ok(Baked { maps, files, report })
+}
+
+/// Each material's file label, made unique by its index where two would be the same.
+fn unique_labels(scene: &Scene, materials: &[usize]) -> Vec<String> {
+    let names = scene.materials();
+    let labels: Vec<String> =
+        materials.iter().map(|&m| file_label(names.get(m).and_then(|x| x.name.as_deref()), m)).collect();
+    labels
+        .iter()
+        .zip(materials)
+        .map(|(l, m)| if labels.iter().filter(|x| *x == l).count() > 1 { format!("{l}_{m}") } else { l.clone() })
+        .collect()
 }
 
 fn check(s: &Settings) -> Result<()> {
@@ -259,7 +378,10 @@ fn check(s: &Settings) -> Result<()> {
 
 struct Ctx<'a> {
     low: &'a Low,
-    bvh: &'a bvh::Bvh,
+    sets: &'a Sets,
+    /// Per LOW part, the set of HIGH parts its rays meet.
+    low_set: &'a [usize],
+    parts: usize,
     normals: &'a [[f32; 3]],
     /// `None`: normals follow the positions' indices.
     normal_triangles: Option<&'a [[u32; 3]]>,
@@ -274,7 +396,7 @@ struct Sample {
 }
 
 impl Ctx<'_> {
-    fn trace(&self, s: &Settings, progress: Progress) -> (Vec<Texel>, Counts) {
+    fn trace(&self, s: &Settings, progress: Progress) -> (Vec<Texel>, Counts, Vec<PartStats>) {
         let (w, h, n) = (s.width, s.height, s.samples);
         let low = self.low;
         let mut c = Counts::default();
@@ -303,7 +425,7 @@ impl Ctx<'_> {
         }
         let mut texels = vec![Texel::default(); w * h];
         let done = std::sync::atomic::AtomicUsize::new(0);
-        let band_counts: Vec<Counts> = texels
+        let band_counts: Vec<(Counts, Vec<PartStats>)> = texels
             .par_chunks_mut(BAND * w)
             .enumerate()
             .map(|(b, out)| {
@@ -316,7 +438,9 @@ impl Ctx<'_> {
                 r
             })
             .collect();
-        for b in band_counts {
+        let mut parts = vec![PartStats::default(); self.parts];
+        for (b, ps) in band_counts {
+            parts.iter_mut().zip(&ps).for_each(|(a, x)| a.add(x));
             c.rays += b.rays;
             c.missed_rays += b.missed_rays;
             c.overlapping_samples += b.overlapping_samples;
@@ -330,8 +454,11 @@ impl Ctx<'_> {
                 _ => {}
             }
             c.texels_with_misses += (x.missed > 0) as usize;
+            if x.state > 0 {
+                parts[x.part as usize].texels += 1;
+            }
         }
-        (texels, c)
+        (texels, c, parts)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -344,8 +471,9 @@ impl Ctx<'_> {
         w: usize,
         n: usize,
         out: &mut [Texel],
-    ) -> Counts {
+    ) -> (Counts, Vec<PartStats>) {
         let mut c = Counts::default();
+        let mut parts = vec![PartStats::default(); self.parts];
         let samples = raster::band(edges, cand, y0, y1, w, n);
         c.overlapping_samples = samples.overlapping;
         let sw = w * n;
@@ -359,7 +487,13 @@ impl Ctx<'_> {
             let texel = (sy / n) * w + sx / n;
             let e = edges[t as usize].as_ref().expect("owners have edges");
             let r = self.sample(t as usize, e.bary(x, y), &mut c);
+            let part = self.low.tri_part[t as usize];
+            let ps = &mut parts[part as usize];
+            ps.rays += 1;
             let o = &mut out[texel];
+            if o.samples == 0 {
+                o.part = part;
+            }
             o.state = o.state.max(if samples.inside(s) { 2 } else { 1 });
             o.samples += 1;
             sums[texel] += r.ts;
@@ -367,8 +501,12 @@ impl Ctx<'_> {
                 Some(d) => {
                     o.height += d;
                     o.hits += 1;
+                    ps.hit(d);
                 }
-                None => o.missed += 1,
+                None => {
+                    o.missed += 1;
+                    ps.missed_rays += 1;
+                }
             }
         }
         for (o, s) in out.iter_mut().zip(sums) {
@@ -380,7 +518,7 @@ impl Ctx<'_> {
                 }
             }
         }
-        c
+        (c, parts)
     }
 
     /// One ray from LOW triangle `t` at barycentrics `b`.
@@ -417,13 +555,16 @@ impl Ctx<'_> {
             }
             None => (nhat, self.front as f32, self.back as f32),
         };
-        let Some(hit) = raycast::nearest(self.bvh, &raycast::Ray::new(p, dir), back, front) else {
+        let set = self.low_set[low.tri_part[t] as usize];
+        let tree = &self.sets.bvhs[set];
+        let Some(hit) = raycast::nearest(tree, &self.sets.positions, &raycast::Ray::new(p, dir), back, front) else {
             c.missed_rays += 1;
             return flat;
         };
+        let id = self.sets.ids[set].as_ref().map_or(hit.id, |v| v[hit.id as usize]);
         let ni = match self.normal_triangles {
-            Some(nt) => nt[hit.id as usize],
-            None => self.bvh.tris[hit.slot as usize],
+            Some(nt) => nt[id as usize],
+            None => tree.tris[hit.slot as usize],
         };
         let n = |k: usize| Vec3A::from(self.normals[ni[k] as usize]) * hit.bary[k];
         let hn = (n(0) + n(1) + n(2)).normalize_or_zero();
@@ -509,48 +650,4 @@ fn png_of(img: image::DynamicImage, path: &std::path::Path) -> Result<Vec<u8>> {
     let mut out = std::io::Cursor::new(Vec::new());
     img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| Error::output(path, e))?;
     Ok(out.into_inner())
-}
-
-impl TransferReport {
-    pub fn text(&self) -> String {
-        let c = &self.counts;
-        let tris: usize = self.high.iter().map(|h| h.triangles).sum();
-        let mut s = format!(
-            "  from {} HIGH file(s), {tris} triangles, onto {} LOW triangles: {}x{}, {} sample(s) per texel, rays {:.4} out / {:.4} in\n",
-            self.high.len(),
-            self.low_triangles,
-            self.width,
-            self.height,
-            self.samples_per_texel,
-            self.ray_front,
-            self.ray_back
-        );
-        s += &format!(
-            "  texels: {} covered, {} at island borders, {} padded, {} left flat\n",
-            c.covered, c.extended, c.padded, c.uncovered
-        );
-        s += &format!(
-            "  rays: {}, {} missed HIGH ({} texels; flat there{})\n",
-            c.rays,
-            c.missed_rays,
-            c.texels_with_misses,
-            if c.missed_rays > 0 { ", see --miss-mask" } else { "" }
-        );
-        if c.overlapping_samples > 0 || c.zero_uv_triangles > 0 {
-            s += &format!(
-                "  UVs: {} samples in overlapping triangles (first triangle baked), {} triangles without UV area\n",
-                c.overlapping_samples, c.zero_uv_triangles
-            );
-        }
-        if c.clamped_below > 0 || c.degenerate_frames > 0 {
-            s += &format!(
-                "  {} hit normals facing away from LOW (clamped), {} degenerate LOW frames (flat)\n",
-                c.clamped_below, c.degenerate_frames
-            );
-        }
-        if let Some([lo, hi]) = self.height_range {
-            s += &format!("  HIGH lies {lo:.5} to {hi:.5} from LOW along the rays (scene units)\n");
-        }
-        s
-    }
 }

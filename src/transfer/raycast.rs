@@ -116,7 +116,7 @@ fn gap(a: f32, b: f32) -> f32 {
 }
 
 /// The hit nearest the ray's origin with `t` in `[-back, front]`.
-pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
+pub fn nearest(bvh: &Bvh, positions: &[[f32; 3]], ray: &Ray, back: f32, front: f32) -> Option<Hit> {
     if bvh.is_empty() {
         return None;
     }
@@ -133,7 +133,7 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
         let n = &bvh.nodes[node];
         if n.n > 0 {
             for k in n.a as usize..(n.a + n.n) as usize {
-                if let Some((t, bary)) = intersect(ray, &bvh.corners(k)) {
+                if let Some((t, bary)) = intersect(ray, &bvh.corners(positions, k)) {
                     if t < lo || t > hi {
                         continue;
                     }
@@ -234,11 +234,11 @@ mod tests {
     fn nearest_on_either_side() {
         let sheet = |z: f32| [Vec3A::new(-1.0, -1.0, z), Vec3A::new(1.0, -1.0, z), Vec3A::new(0.0, 1.0, z)];
         let tris: Vec<[Vec3A; 3]> = [0.5f32, -0.2, 0.9, -0.7].iter().map(|&z| sheet(z)).collect();
-        let bvh = crate::transfer::bvh::tests::soup(&tris);
+        let (bvh, pos) = crate::transfer::bvh::tests::soup(&tris);
         let r = Ray::new(Vec3A::ZERO, Vec3A::Z);
-        let h = nearest(&bvh, &r, 1.0, 1.0).unwrap();
+        let h = nearest(&bvh, &pos, &r, 1.0, 1.0).unwrap();
         assert_eq!((h.id, h.t), (1, -0.2));
-        assert_eq!(nearest(&bvh, &r, 0.1, 0.6).unwrap().id, 0);
-        assert!(nearest(&bvh, &r, 0.1, 0.4).is_none());
+        assert_eq!(nearest(&bvh, &pos, &r, 0.1, 0.6).unwrap().id, 0);
+        assert!(nearest(&bvh, &pos, &r, 0.1, 0.4).is_none());
     }
 }

@@ -93,8 +93,13 @@ codes! {
     NORMALMAP_Z_NEGATIVE = Error, "a tangent-space normal map has z >= 0 everywhere (blue >= 128); is this an object-space map or a packed (two-channel) map?";
     /// Texels decode to vectors far from unit length (|len - 1| > 0.1).
     NORMALMAP_NOT_UNIT = Warning, "renormalise the map; is this a height map, a packed or a colour-managed (sRGB) image?";
-    /// Every texel is the flat normal (0, 0, 1).
+    /// Every texel is the flat normal (0, 0, 1), to within 8-bit rounding.
     NORMALMAP_FLAT = Warning, "the map changes nothing: remove normalTexture or check the bake";
+    /// The largest tilt of any texel is below 2°: the map barely changes the shading.
+    NORMALMAP_NEARLY_FLAT = Warning, "re-make the map at a higher strength (`bumpbake normalmap` and `bumpbake bake --height` name one that shows the relief) or remove the normal texture";
+    /// Scattered texels off unit length (or just below z = 0) in a lossy-coded map (JPEG, lossy
+    /// WebP, ETC1S, UASTC), no more than the codec's error explains.
+    NORMALMAP_CODEC_NOISE = Info, "nothing to fix: compression noise; store the map lossless (PNG, UASTC at a higher level) if these texels matter";
     /// The green channel follows the other convention than the one expected.
     NORMALMAP_GREEN_FLIPPED = Error, "invert the green channel (glTF expects OpenGL, +Y up); `bumpbake normalmap` writes either convention";
 }

@@ -49,7 +49,6 @@ pub fn check(d: &PrimData, max_angle_deg: f64, ex: &mut Explained, s: &mut Subje
             return;
         }
     };
-    let flip = if d.uv_v_up { 1.0 } else { -1.0 };
     // What quantization explains, per vertex, on top of the threshold (none for float data).
     let (slack, may_flip) = d.quant.slack(&d.positions, &uvs_c, &d.indices);
     let frame_slack = d.quant.frame_angle();
@@ -63,7 +62,7 @@ pub fn check(d: &PrimData, max_angle_deg: f64, ex: &mut Explained, s: &mut Subje
             continue;
         }
         let stored = t[v];
-        let ref_w = r[3] * flip;
+        let ref_w = crate::tangent::gltf_w(r[3]);
         if (stored[3] > 0.0) != (ref_w > 0.0) {
             if may_flip.get(c / 3).copied().unwrap_or(false) {
                 // Rounding may have turned the triangle over in UV space: its frame says nothing.

@@ -26,8 +26,6 @@ pub struct PrimData {
     pub tangents: Option<Vec<[f32; 4]>>,
     /// Three per triangle, each in range.
     pub indices: Vec<u32>,
-    /// UVs have v up (OBJ): the stored `w` is the MikkTSpace sign itself, not its negation.
-    pub uv_v_up: bool,
     /// How coarsely the file stores what the checks compare (zero for floats).
     pub quant: Quant,
 }

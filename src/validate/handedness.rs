@@ -2,7 +2,7 @@
 //!
 //! The conventions define the bitangent as `B = cross(N, t) * w`, and the shader multiplies the
 //! map's `+Y` (image up) by it, so `B` must point the way the image's up direction runs across the
-//! triangle. For glTF UVs (v down) up is `-dP/dv`; for OBJ UVs (v up) it is `+dP/dv`.
+//! triangle. glTF's UVs run v down (OBJ's are turned so at load), so up is `-dP/dv`.
 //!
 //! MikkTSpace decides the sign from the UV winding alone, which is the same thing when the triangle
 //! is wound counter-clockwise around its normals. On a triangle wound against its own normals the
@@ -38,9 +38,10 @@ pub fn expected_w(d: &PrimData, ex: &Explained) -> Vec<i8> {
         }
         let dpdu = (e1 * d2.y - e2 * d1.y) / r;
         let dpdv = (e2 * d1.x - e1 * d2.x) / r;
-        let up = if d.uv_v_up { dpdv } else { -dpdv };
-        // MikkTSpace's own answer: positive UV area means orientation preserved (sign +1).
-        let mikk_w: i8 = if (r > 0.0) == d.uv_v_up { 1 } else { -1 };
+        let up = -dpdv;
+        // MikkTSpace's own answer: positive UV area means orientation preserved (reference sign
+        // +1), stored as glTF's `w`.
+        let mikk_w = crate::tangent::gltf_w(if r > 0.0 { 1.0 } else { -1.0 }) as i8;
         for (j, &v) in tri.iter().enumerate() {
             let n = d3(normals[v as usize]);
             let b = n.cross(dpdu);

@@ -18,6 +18,7 @@ mod codes;
 pub mod conformance;
 pub mod frames;
 pub mod handedness;
+pub mod lossy;
 pub mod normal_image;
 pub mod report;
 mod scene_checks;
@@ -301,7 +302,8 @@ pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
         })?;
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let mut subject = Subject::new("image", name);
-        validate_normal_image(&img, opts.image_convention, "the command line", &mut subject);
+        let codec = lossy::Codec::sniff(&bytes);
+        validate_normal_image(&img, codec, opts.image_convention, "the command line", &mut subject);
         FileReport { path: path.to_path_buf(), kind: "image", subjects: vec![subject] }
     };
     apply_policy(&mut rep, opts);
@@ -314,10 +316,17 @@ pub fn validate_scene(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     scene_checks::run(scene, opts)
 }
 
-/// Checks a decoded normal-map image: z < 0, non-unit texels, all flat, and its green-channel
-/// convention against `expected` (`wanted_by` names who expects it, for the message).
-pub fn validate_normal_image(img: &image::DynamicImage, expected: Convention, wanted_by: &str, subject: &mut Subject) {
-    normal_image::check(img, expected, wanted_by, subject)
+/// Checks a decoded normal-map image: z < 0, non-unit texels (judged by how its bytes were
+/// coded: `lossy::Codec::sniff`), (nearly) flat, and its green-channel convention against
+/// `expected` (`wanted_by` names who expects it, for the message).
+pub fn validate_normal_image(
+    img: &image::DynamicImage,
+    codec: lossy::Codec,
+    expected: Convention,
+    wanted_by: &str,
+    subject: &mut Subject,
+) {
+    normal_image::check(img, codec, expected, wanted_by, subject)
 }
 
 /// Moves single checks up (`deny`) or down (`allow`) in severity.

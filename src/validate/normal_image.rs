@@ -15,7 +15,10 @@
 //! `|E_flip - E_as| / (E_flip + E_as)`: 0 when the map cannot tell (flat, separable `f(x) + g(y)`
 //! relief, pure noise, hand-painted detail), near 1 for any height-field bake with twist.
 
+use super::lossy;
+pub use super::lossy::Codec;
 use super::{Code, Example, Finding, Subject, Worst};
+use crate::normalmap::{Flatness, Verdict};
 use image::{DynamicImage, Rgb32FImage, RgbImage};
 
 /// Which way a normal map's green channel runs.
@@ -136,8 +139,9 @@ pub fn detect(t: &Texels) -> Detection {
     Detection { convention, confidence, curl_as_is: per(e_as), curl_flipped: per(e_flip), samples }
 }
 
-/// All checks on one normal-map image; `wanted_by` says who expects `expected`.
-pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut Subject) {
+/// All checks on one normal-map image; `codec` is how its bytes were coded
+/// ([`Codec::sniff`]), `wanted_by` says who expects `expected`.
+pub fn check(img: &DynamicImage, codec: Codec, expected: Convention, wanted_by: &str, s: &mut Subject) {
     let rgb8;
     let rgbf;
     let texels = match img {
@@ -155,11 +159,15 @@ pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut 
     };
     let (w, h) = texels.dimensions();
     let total = w as usize * h as usize;
-    let (mut neg, mut nonunit, mut flat) = (0usize, 0usize, 0usize);
+    let (mut neg, mut nonunit) = (0usize, 0usize);
     let (mut w_neg, mut w_nu) = (Worst::default(), Worst::default());
+    let mut flat = Flatness::default();
+    // |n| - 1 of every finite texel: the map's own statistics for the lossy rule.
+    let mut devs: Vec<f32> = Vec::with_capacity(if codec.is_lossy() { total } else { 0 });
     for y in 0..h {
         for x in 0..w {
             let n = texels.normal(x, y);
+            flat.push(n);
             let texel = |detail: String| Example {
                 kind: "texel",
                 index: y as u64 * w as u64 + x as u64,
@@ -173,69 +181,153 @@ pub fn check(img: &DynamicImage, expected: Convention, wanted_by: &str, s: &mut 
                 });
                 continue;
             }
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if codec.is_lossy() {
+                devs.push(len - 1.0);
+            }
             // Half an 8-bit step below zero: 127 is negative, 128 (z = 0 rounded) is not.
             if n[2] < -0.002 {
                 neg += 1;
                 w_neg.push(-n[2] as f64, || texel(format!("decodes to ({:.3}, {:.3}, {:.3})", n[0], n[1], n[2])));
                 continue;
             }
-            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            if (len - 1.0).abs() > 0.1 {
+            if (len - 1.0).abs() as f64 > lossy::UNIT_TOLERANCE {
                 nonunit += 1;
                 w_nu.push((len - 1.0).abs() as f64, || {
                     texel(format!("decodes to ({:.3}, {:.3}, {:.3}), length {len:.3}", n[0], n[1], n[2]))
                 });
             }
-            if n[0].abs() < 0.02 && n[1].abs() < 0.02 && n[2] > 0.98 {
-                flat += 1;
-            }
         }
     }
-    s.check(
-        Code::NORMALMAP_Z_NEGATIVE,
-        (neg > 0).then(|| {
-            Finding::new(
-                Code::NORMALMAP_Z_NEGATIVE,
-                neg,
-                total,
-                "texels",
-                format!("{neg} of {total} texels decode to z < 0 (pointing into the surface)"),
+    let median = lossy::median_abs(&mut devs);
+    drop(devs);
+    let off = neg + nonunit;
+    let explained = codec.is_lossy()
+        && off > 0
+        && median <= lossy::median_bound(codec)
+        && off as f64 <= lossy::allowance(codec) * total as f64;
+    if explained {
+        s.check(Code::NORMALMAP_Z_NEGATIVE, None);
+        s.check(Code::NORMALMAP_NOT_UNIT, None);
+        s.check(Code::NORMALMAP_CODEC_NOISE, Some(codec_noise(codec, neg, nonunit, total, median, w_nu, w_neg)));
+    } else {
+        let systematic = if codec.is_lossy() {
+            format!(
+                "; more than {} coding explains (median |length - 1| {median:.3}, at most {:.3} and {:.1}% of texels allowed)",
+                codec.name(),
+                lossy::median_bound(codec),
+                100.0 * lossy::allowance(codec)
             )
-            .examples(w_neg.into_examples())
-        }),
-    );
-    s.check(
-        Code::NORMALMAP_NOT_UNIT,
-        (nonunit > 0).then(|| {
-            Finding::new(
-                Code::NORMALMAP_NOT_UNIT,
-                nonunit,
-                total,
-                "texels",
-                format!("{nonunit} of {total} texels decode to vectors more than 10% off unit length"),
-            )
-            .examples(w_nu.into_examples())
-        }),
-    );
-    let all_flat = total > 0 && flat == total;
+        } else {
+            String::new()
+        };
+        s.check(
+            Code::NORMALMAP_Z_NEGATIVE,
+            (neg > 0).then(|| {
+                Finding::new(
+                    Code::NORMALMAP_Z_NEGATIVE,
+                    neg,
+                    total,
+                    "texels",
+                    format!("{neg} of {total} texels decode to z < 0 (pointing into the surface){systematic}"),
+                )
+                .examples(w_neg.into_examples())
+            }),
+        );
+        s.check(
+            Code::NORMALMAP_NOT_UNIT,
+            (nonunit > 0).then(|| {
+                let f = Finding::new(
+                    Code::NORMALMAP_NOT_UNIT,
+                    nonunit,
+                    total,
+                    "texels",
+                    format!("{nonunit} of {total} texels decode to vectors more than 10% off unit length{systematic}"),
+                )
+                .examples(w_nu.into_examples());
+                if codec.is_lossy() {
+                    f.metric("median_length_error", median).metric("allowed_fraction", lossy::allowance(codec))
+                } else {
+                    f
+                }
+            }),
+        );
+        if codec.is_lossy() {
+            s.check(Code::NORMALMAP_CODEC_NOISE, None);
+        }
+    }
+    let tilt = flat.max_tilt_deg();
     s.check(
         Code::NORMALMAP_FLAT,
-        all_flat.then(|| {
+        (flat.verdict() == Verdict::Flat).then(|| {
             Finding::new(
                 Code::NORMALMAP_FLAT,
                 total,
                 total,
                 "texels",
-                format!("every texel of this {w}x{h} map is the flat normal (0, 0, 1)"),
+                format!("every texel of this {w}x{h} map is the flat normal (0, 0, 1) to within 8-bit rounding (largest tilt {tilt:.2}°)"),
             )
+            .metric("max_tilt_deg", tilt)
         }),
     );
-    if all_flat {
+    if flat.verdict() == Verdict::Flat {
         return;
     }
+    s.check(
+        Code::NORMALMAP_NEARLY_FLAT,
+        (flat.verdict() == Verdict::NearlyFlat).then(|| {
+            Finding::new(
+                Code::NORMALMAP_NEARLY_FLAT,
+                total,
+                total,
+                "texels",
+                format!(
+                    "the largest tilt of any texel of this {w}x{h} map is {tilt:.2}° (nearly flat: below {:.0}°), so it barely changes the shading",
+                    crate::normalmap::NEARLY_FLAT_DEG
+                ),
+            )
+            .metric("max_tilt_deg", tilt)
+        }),
+    );
     let d = detect(&texels);
     s.convention = Some(d);
     s.check(Code::NORMALMAP_GREEN_FLIPPED, green_finding(&d, expected, wanted_by));
+}
+
+/// The one info finding for texels a lossy coding explains.
+fn codec_noise(
+    codec: Codec,
+    neg: usize,
+    nonunit: usize,
+    total: usize,
+    median: f64,
+    w_nu: Worst,
+    w_neg: Worst,
+) -> Finding {
+    let off = neg + nonunit;
+    let what = match (nonunit, neg) {
+        (n, 0) => format!("{n} texels decode more than 10% off unit length"),
+        (0, z) => format!("{z} texels decode to z slightly below 0"),
+        (n, z) => format!("{n} texels decode more than 10% off unit length and {z} to z slightly below 0"),
+    };
+    let mut examples = w_nu.into_examples();
+    examples.extend(w_neg.into_examples());
+    examples.truncate(super::MAX_EXAMPLES);
+    Finding::new(
+        Code::NORMALMAP_CODEC_NOISE,
+        off,
+        total,
+        "texels",
+        format!(
+            "{what} ({:.3}% of {total}), scattered: within what {} coding explains (up to {:.1}%; the median texel is {median:.4} off unit length)",
+            100.0 * off as f64 / total.max(1) as f64,
+            codec.name(),
+            100.0 * lossy::allowance(codec)
+        ),
+    )
+    .examples(examples)
+    .metric("median_length_error", median)
+    .metric("allowed_fraction", lossy::allowance(codec))
 }
 
 fn green_finding(d: &Detection, expected: Convention, wanted_by: &str) -> Option<Finding> {

@@ -73,17 +73,17 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             tangents: p.attr("TANGENT").map(|s| s.to_f32::<4>()),
             quant,
             indices: p.indices,
-            uv_v_up: scene.uv_v_up,
         };
         let wanted_by = need.map(|n| n.describe());
         subjects.push((s, Some((d, wanted_by))));
     }
     let max_angle = opts.max_angle_deg;
+    let stores_tangents = scene.source_format.stores_tangents();
     let mut done: Vec<Subject> = subjects
         .into_par_iter()
         .map(|(mut s, data)| {
             if let Some((d, wanted_by)) = data {
-                check_primitive(&d, wanted_by.as_deref(), max_angle, scene.uv_v_up, &mut s);
+                check_primitive(&d, wanted_by.as_deref(), max_angle, stores_tangents, &mut s);
             }
             s
         })
@@ -132,12 +132,12 @@ fn prim_name(scene: &Scene, r: PrimRef) -> String {
 /// Every check of one primitive, in the order that lets later checks skip what earlier ones
 /// explained. `wanted_by` says what needs tangents (a normal, clearcoat normal or anisotropy
 /// texture of a material the primitive can show), if anything does.
-fn check_primitive(d: &PrimData, wanted_by: Option<&str>, max_angle_deg: f64, from_obj: bool, s: &mut Subject) {
+fn check_primitive(d: &PrimData, wanted_by: Option<&str>, max_angle_deg: f64, stores_tangents: bool, s: &mut Subject) {
     let uses_map = wanted_by.is_some();
     let has_t = d.tangents.is_some();
     let has_n = d.normals.is_some();
-    // OBJ cannot store tangents: the renderer that loads it always makes its own.
-    if uses_map && !from_obj {
+    // A format that cannot store tangents (OBJ) leaves them to the renderer that loads it.
+    if uses_map && stores_tangents {
         s.check(
             Code::TANGENT_MISSING,
             (!has_t).then(|| {
@@ -327,8 +327,9 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
                 s.check(Code::NORMALMAP_NOT_DECODED, Some(f));
                 return s;
             }
+            let codec = bytes.as_deref().map(normal_image::Codec::sniff).unwrap_or(normal_image::Codec::Lossless);
             match bytes.and_then(|b| image::decode(&b)) {
-                Ok(img) => normal_image::check(&img, Convention::OpenGl, &wanted_by, &mut s),
+                Ok(img) => normal_image::check(&img, codec, Convention::OpenGl, &wanted_by, &mut s),
                 Err(e) => s.check(
                     Code::NORMALMAP_UNREADABLE,
                     Some(Finding::new(

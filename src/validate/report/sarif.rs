@@ -43,7 +43,11 @@ fn description(code: Code) -> &'static str {
         NORMALMAP_NOT_DECODED => "A normal-map image in a format bumpbake does not decode (KTX2, AVIF): not checked.",
         NORMALMAP_Z_NEGATIVE => "Normal-map texels decode to z < 0: they point into the surface.",
         NORMALMAP_NOT_UNIT => "Normal-map texels decode to vectors more than 10% off unit length.",
-        NORMALMAP_FLAT => "Every texel of the normal map is the flat normal (0, 0, 1).",
+        NORMALMAP_FLAT => "Every texel of the normal map is the flat normal (0, 0, 1), to within 8-bit rounding.",
+        NORMALMAP_NEARLY_FLAT => "The largest tilt of any normal-map texel is below 2 degrees: the map barely shows.",
+        NORMALMAP_CODEC_NOISE => {
+            "Scattered texels of a lossy-coded normal map off unit length, within the codec's error."
+        }
         NORMALMAP_GREEN_FLIPPED => "The normal map's green channel follows the other convention than the one expected.",
     }
 }

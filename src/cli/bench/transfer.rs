@@ -65,7 +65,7 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
     }
     let plan = Plan { millions, sources, size: a.large_size };
     let quiet = a.json;
-    let r = super::bench::with_scratch("transfer", |exe, dir| {
+    let r = super::shared::with_scratch("transfer", |exe, dir| {
         let mut r = if a.runs == 0 {
             bumpbake::bench::transfer::Report::empty()
         } else {
@@ -98,6 +98,6 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
         })?;
         Ok(r)
     })?;
-    super::bench::print(&r, a.json, bumpbake::bench::transfer::table)?;
+    super::shared::print(&r, a.json, bumpbake::bench::transfer::table)?;
     Ok(0)
 }

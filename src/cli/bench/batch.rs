@@ -22,10 +22,10 @@ pub struct BenchBatchArgs {
 }
 
 pub fn run(a: BenchBatchArgs) -> Result<u8> {
-    let r = super::bench::with_scratch("batch", |exe, dir| {
+    let r = super::shared::with_scratch("batch", |exe, dir| {
         bumpbake::bench::batch::run(exe, dir, a.assets, a.jobs, a.runs)
     })?;
-    super::bench::print(&r, a.json, |r| {
+    super::shared::print(&r, a.json, |r| {
         format!(
             "{} assets: one process each {:.0} ms, one batch with -j {} {:.0} ms (medians of {}): ratio {:.2} (target <= 0.6)",
             r.assets, r.one_by_one_ms, r.jobs, r.batch_ms, r.runs, r.ratio

@@ -20,8 +20,8 @@ pub struct BenchCommandArgs {
 
 pub fn run(a: BenchCommandArgs) -> Result<u8> {
     let r =
-        super::bench::with_scratch("command", |exe, dir| bumpbake::bench::command::run(exe, &a.input, dir, a.runs))?;
-    super::bench::print(&r, a.json, |r| {
+        super::shared::with_scratch("command", |exe, dir| bumpbake::bench::command::run(exe, &a.input, dir, a.runs))?;
+    super::shared::print(&r, a.json, |r| {
         format!(
             "tangents {} ({:.1} MB) -> {:.1} MB: median {:.2} s (min {:.2}, max {:.2}, {} runs); peak memory {:.1} MB = {:.2}x the input",
             r.input.display(),
