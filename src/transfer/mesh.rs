@@ -58,7 +58,8 @@ impl High {
         if normals.is_empty() {
             normal_triangles = Vec::with_capacity(triangles.len());
             for k in 0..raw.parts.len().max(1) {
-                let r = if raw.parts.is_empty() { 0..triangles.len() } else { part_range(&raw.parts, k, triangles.len()) };
+                let r =
+                    if raw.parts.is_empty() { 0..triangles.len() } else { part_range(&raw.parts, k, triangles.len()) };
                 let tris = &triangles[r];
                 let Some(lo) = tris.iter().flatten().min().copied() else { continue };
                 let hi = tris.iter().flatten().max().copied().unwrap_or(lo);
