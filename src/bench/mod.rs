@@ -9,6 +9,7 @@ pub mod surfaces;
 pub mod tangents;
 pub mod tangents_plot;
 pub mod transfer;
+pub mod transfer_large;
 
 /// The median of `v` (sorted in place), the mean of the middle two for an even count; 0 when empty.
 pub(crate) fn median(v: &mut [f64]) -> f64 {

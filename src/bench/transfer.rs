@@ -381,6 +381,8 @@ pub struct Row {
     pub bvh_ms: f64,
     pub rays_ms: f64,
     pub peak_mb: f64,
+    /// What the baker's HIGH (tree, positions, triangles, normals) takes, per triangle.
+    pub high_bytes_per_triangle: f64,
     pub error: Evaluation,
 }
 
@@ -393,11 +395,13 @@ pub struct Report {
     pub quality: Vec<Row>,
     /// Time against HIGH's triangle count (1024², one sample).
     pub scaling: Vec<Row>,
+    /// Production-scale HIGH (millions of triangles) from memory and from files.
+    pub large: Vec<super::transfer_large::LargeRow>,
 }
 
 /// Runs `exe bake low --from high` `runs` times and measures the last output.
 #[allow(clippy::too_many_arguments)]
-fn time_one(
+pub(crate) fn time_one(
     exe: &Path,
     dir: &Path,
     low: &Path,
@@ -410,6 +414,7 @@ fn time_one(
 ) -> Result<Row> {
     let out = dir.join(format!("out_{tris}_{size}_{samples}.glb"));
     let (mut times, mut stages, mut peak) = (Vec::new(), [Vec::new(), Vec::new(), Vec::new()], 0u64);
+    let mut high_bytes = 0.0;
     for _ in 0..runs.max(1) {
         let t = std::time::Instant::now();
         let o = std::process::Command::new(exe)
@@ -430,6 +435,7 @@ fn time_one(
         }
         peak = peak.max(super::command::peak_of(&stderr).unwrap_or(0));
         let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap_or_default();
+        high_bytes = j.pointer("/transfer/high_bytes").and_then(|b| b.as_f64()).unwrap_or(f64::NAN);
         let st = j.pointer("/transfer/timings_ms/stages").and_then(|s| s.as_array()).cloned().unwrap_or_default();
         for (k, name) in ["read high", "bvh", "rays"].iter().enumerate() {
             let ms = st.iter().find(|s| s[0] == *name).and_then(|s| s[1].as_f64()).unwrap_or(f64::NAN);
@@ -454,12 +460,32 @@ fn time_one(
         bvh_ms: super::median(&mut b),
         rays_ms: super::median(&mut c),
         peak_mb: peak as f64 * 1024.0 / 1e6,
+        high_bytes_per_triangle: high_bytes / tris as f64,
         error,
     })
 }
 
 /// The HIGH tessellations of the scaling series: quads around the ring and around the tube.
 pub const HIGHS: [(usize, usize); 4] = [(274, 68), (548, 137), (1096, 274), (1550, 387)];
+
+impl Report {
+    /// A report with no rows yet.
+    pub fn empty() -> Report {
+        let t = Torus::default();
+        Report {
+            torus: describe(&t),
+            low_triangles: 2 * 48 * 24,
+            threads: rayon::current_num_threads(),
+            quality: Vec::new(),
+            scaling: Vec::new(),
+            large: Vec::new(),
+        }
+    }
+}
+
+fn describe(t: &Torus) -> String {
+    format!("R {} r {} displaced by {}·(sin 8θ sin 4φ + ½ cos(3θ+6φ)); LOW 48x24 quads", t.major, t.minor, t.amp)
+}
 
 /// The whole bench: `quality` lists `(size, samples)` pairs run on the 600k-triangle HIGH.
 pub fn run(
@@ -488,14 +514,12 @@ pub fn run(
         let _ = std::fs::remove_file(&high);
     }
     Ok(Report {
-        torus: format!(
-            "R {} r {} displaced by {}·(sin 8θ sin 4φ + ½ cos(3θ+6φ)); LOW 48x24 quads",
-            torus.major, torus.minor, torus.amp
-        ),
+        torus: describe(&torus),
         low_triangles: 2 * 48 * 24,
         threads: rayon::current_num_threads(),
         quality: rows,
         scaling,
+        large: Vec::new(),
     })
 }
 
@@ -520,6 +544,10 @@ pub fn table(r: &Report) -> String {
             row.error.synced.p99,
             row.error.normalised_frame.mean
         );
+    }
+    if !r.large.is_empty() {
+        s += "\n";
+        s += &super::transfer_large::table(&r.large);
     }
     s
 }

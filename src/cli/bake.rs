@@ -185,6 +185,7 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         matching: a.matching,
         node: a.node.clone(),
         progress,
+        ..Default::default()
     }))
 }
 

@@ -17,7 +17,7 @@ pub mod weld;
 
 pub use accessor::{Format, Stream};
 pub use material::{Materials, PrimNeed, Slot, TangentNeed, UvTransform};
-pub use normals::{flat_normals, smooth_normals};
+pub use normals::{flat_normals, smooth_normals, smooth_vertex_normals};
 
 use crate::error::{Error, Result};
 use accessor::*;

@@ -27,8 +27,36 @@ pub(crate) fn face_normal(a: glam::Vec3, b: glam::Vec3, c: glam::Vec3) -> Option
 /// how many corners had none (only degenerate faces around them).
 pub fn smooth_normals(positions: &[f32], indices: &[u32]) -> (Vec<[f32; 3]>, usize) {
     let p = |i: u32| glam::Vec3::from_slice(&positions[i as usize * 3..i as usize * 3 + 3]);
-    let mut acc = vec![glam::Vec3::ZERO; positions.len() / 3];
-    for t in indices.chunks_exact(3) {
+    let acc = accumulate(positions.len() / 3, p, indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
+    let mut fixed = 0;
+    let out = indices
+        .iter()
+        .map(|&i| {
+            unit_or_z(acc[i as usize]).unwrap_or_else(|| {
+                fixed += 1;
+                [0.0, 0.0, 1.0]
+            })
+        })
+        .collect();
+    (out, fixed)
+}
+
+/// The same normals once per vertex rather than per corner (for meshes too large to hold
+/// three normals a triangle); vertices with none get +Z.
+pub fn smooth_vertex_normals(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Vec<[f32; 3]> {
+    let p = |i: u32| glam::Vec3::from(positions[i as usize]);
+    let acc = accumulate(positions.len(), p, triangles.iter().copied());
+    acc.into_iter().map(|n| unit_or_z(n).unwrap_or([0.0, 0.0, 1.0])).collect()
+}
+
+/// Each vertex's sum of face normals weighted by the face's angle there.
+fn accumulate(
+    vertices: usize,
+    p: impl Fn(u32) -> glam::Vec3,
+    triangles: impl Iterator<Item = [u32; 3]>,
+) -> Vec<glam::Vec3> {
+    let mut acc = vec![glam::Vec3::ZERO; vertices];
+    for t in triangles {
         let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
         let Some(n) = face_normal(a, b, c) else { continue };
         for (k, (o, u, v)) in [(a, b, c), (b, c, a), (c, a, b)].into_iter().enumerate() {
@@ -38,20 +66,12 @@ pub fn smooth_normals(positions: &[f32], indices: &[u32]) -> (Vec<[f32; 3]>, usi
             acc[t[k] as usize] += n * angle;
         }
     }
-    let mut fixed = 0;
-    let out = indices
-        .iter()
-        .map(|&i| {
-            let n = pow2_scaled(acc[i as usize]).normalize_or_zero();
-            if n == glam::Vec3::ZERO || !n.is_finite() {
-                fixed += 1;
-                [0.0, 0.0, 1.0]
-            } else {
-                n.to_array()
-            }
-        })
-        .collect();
-    (out, fixed)
+    acc
+}
+
+fn unit_or_z(sum: glam::Vec3) -> Option<[f32; 3]> {
+    let n = pow2_scaled(sum).normalize_or_zero();
+    (n != glam::Vec3::ZERO && n.is_finite()).then(|| n.to_array())
 }
 
 /// One normal per face, from per-corner positions; faces without area get +Z.

@@ -2,7 +2,8 @@
 //!
 //! The tree depends on the triangles only, never on the thread count: every split is decided by
 //! the same binned sweep, and subtrees built on other threads are spliced in a fixed order.
-//! Triangles are copied into leaf order so that a leaf's vertices sit together in memory.
+//! HIGH is held once, indexed: the tree holds its triangles' corner indices (into positions that
+//! several trees can share), permuted into leaf order so that a leaf's triangles sit together.
 
 use glam::Vec3A;
 
@@ -16,17 +17,13 @@ pub struct Node {
     pub n: u32,
 }
 
-/// A triangle in leaf order: its three corners and its index in the input.
-#[derive(Debug, Clone, Copy)]
-pub struct Tri {
-    pub v: [Vec3A; 3],
-    pub id: u32,
-}
-
 #[derive(Debug, Clone)]
 pub struct Bvh {
     pub nodes: Vec<Node>,
-    pub tris: Vec<Tri>,
+    /// Corner indices into `positions`, in leaf order.
+    pub tris: Vec<[u32; 3]>,
+    /// Each leaf-order triangle's index in the input.
+    pub ids: Vec<u32>,
 }
 
 const BINS: usize = 16;
@@ -59,26 +56,37 @@ impl Aabb {
     }
 }
 
-/// Per-triangle data the build sorts.
+/// Per-triangle data the build sorts: 28 bytes (the centre is recomputed from the bounds, in the
+/// same arithmetic, rather than stored).
 #[derive(Clone, Copy)]
 struct Item {
-    bounds: Aabb,
-    centre: Vec3A,
+    min: [f32; 3],
+    max: [f32; 3],
     id: u32,
 }
 
+impl Item {
+    fn bounds(&self) -> Aabb {
+        Aabb { min: Vec3A::from(self.min), max: Vec3A::from(self.max) }
+    }
+    fn centre(&self) -> Vec3A {
+        (Vec3A::from(self.min) + Vec3A::from(self.max)) * 0.5
+    }
+}
+
 impl Bvh {
-    /// Builds the tree over `triangles` (three corners each). Every triangle is kept, degenerate
-    /// ones too: the intersection test rejects them, and their ids stay aligned with the input.
-    pub fn build(triangles: &[[Vec3A; 3]]) -> Bvh {
+    /// Builds the tree over `triangles` (corner indices into `positions`, which must be in
+    /// range). Every triangle is kept, degenerate ones too: the intersection test rejects them,
+    /// and their ids stay aligned with the input.
+    pub fn build(positions: &[[f32; 3]], triangles: Vec<[u32; 3]>) -> Bvh {
         use rayon::prelude::*;
         let mut items: Vec<Item> = triangles
             .par_iter()
             .enumerate()
             .map(|(i, t)| {
                 let mut b = Aabb::EMPTY;
-                t.iter().for_each(|&p| b.grow(p));
-                Item { bounds: b, centre: (b.min + b.max) * 0.5, id: i as u32 }
+                t.iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
+                Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
             })
             .collect();
         let nodes = if items.is_empty() {
@@ -86,21 +94,34 @@ impl Bvh {
         } else {
             build_par(&mut items, 0)
         };
-        let tris = items.par_iter().map(|it| Tri { v: triangles[it.id as usize], id: it.id }).collect();
-        Bvh { nodes, tris }
+        let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
+        drop(items);
+        let tris = ids.par_iter().map(|&i| triangles[i as usize]).collect();
+        Bvh { nodes, tris, ids }
     }
 
     /// An empty tree has a root with no triangles.
     pub fn is_empty(&self) -> bool {
         self.tris.is_empty()
     }
+
+    /// The corners of leaf-order triangle `k`.
+    #[inline]
+    pub fn corners(&self, positions: &[[f32; 3]], k: usize) -> [Vec3A; 3] {
+        self.tris[k].map(|i| Vec3A::from(positions[i as usize]))
+    }
+
+    /// Bytes held, for the memory figures.
+    pub fn bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Node>() + self.tris.capacity() * 12 + self.ids.capacity() * 4
+    }
 }
 
 fn bounds_of(items: &[Item]) -> (Aabb, Aabb) {
     let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
     for it in items {
-        b.join(&it.bounds);
-        c.grow(it.centre);
+        b.join(&it.bounds());
+        c.grow(it.centre());
     }
     (b, c)
 }
@@ -129,8 +150,8 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<(usize, usize)> {
     let scale = BINS as f32 / e;
     let mut bins = [(Aabb::EMPTY, 0usize); BINS];
     for it in items {
-        let k = (((it.centre[axis] - c.min[axis]) * scale) as usize).min(BINS - 1);
-        bins[k].0.join(&it.bounds);
+        let k = (((it.centre()[axis] - c.min[axis]) * scale) as usize).min(BINS - 1);
+        bins[k].0.join(&it.bounds());
         bins[k].1 += 1;
     }
     // Sweep from the right, then from the left: the cost of each boundary.
@@ -167,7 +188,7 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<(usize, usize)> {
 /// Moves the items left of bin boundary `k` on `axis` to the front; returns how many there are.
 fn partition(items: &mut [Item], c: &Aabb, axis: usize, k: usize) -> usize {
     let scale = BINS as f32 / (c.max[axis] - c.min[axis]);
-    let side = |it: &Item| (((it.centre[axis] - c.min[axis]) * scale) as usize).min(BINS - 1) < k;
+    let side = |it: &Item| (((it.centre()[axis] - c.min[axis]) * scale) as usize).min(BINS - 1) < k;
     let mut i = 0;
     for j in 0..items.len() {
         if side(&items[j]) {
@@ -230,8 +251,15 @@ fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// A tree over unshared corners, as a triangle soup, and its positions.
+    pub(crate) fn soup(tris: &[[Vec3A; 3]]) -> (Bvh, Vec<[f32; 3]>) {
+        let positions: Vec<[f32; 3]> = tris.iter().flat_map(|t| t.map(|p| p.to_array())).collect();
+        let k = tris.len() as u32;
+        (Bvh::build(&positions, (0..k).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect()), positions)
+    }
 
     fn grid_tris(n: usize) -> Vec<[Vec3A; 3]> {
         let mut t = Vec::new();
@@ -249,27 +277,27 @@ mod tests {
     #[test]
     fn leaves_cover_every_triangle_once_and_boxes_nest() {
         let tris = grid_tris(150);
-        let bvh = Bvh::build(&tris);
+        let (bvh, pos) = soup(&tris);
         let mut seen = vec![0u32; tris.len()];
-        fn walk(b: &Bvh, i: usize, seen: &mut [u32]) -> (Vec3A, Vec3A) {
+        fn walk(b: &Bvh, pos: &[[f32; 3]], i: usize, seen: &mut [u32]) -> (Vec3A, Vec3A) {
             let n = b.nodes[i];
             let (lo, hi) = (Vec3A::from(n.min), Vec3A::from(n.max));
             let (clo, chi) = if n.n > 0 {
                 let mut a = Aabb::EMPTY;
-                for t in &b.tris[n.a as usize..(n.a + n.n) as usize] {
-                    seen[t.id as usize] += 1;
-                    t.v.iter().for_each(|&p| a.grow(p));
+                for k in n.a as usize..(n.a + n.n) as usize {
+                    seen[b.ids[k] as usize] += 1;
+                    b.corners(pos, k).iter().for_each(|&p| a.grow(p));
                 }
                 (a.min, a.max)
             } else {
-                let (l0, l1) = walk(b, i + 1, seen);
-                let (r0, r1) = walk(b, n.a as usize, seen);
+                let (l0, l1) = walk(b, pos, i + 1, seen);
+                let (r0, r1) = walk(b, pos, n.a as usize, seen);
                 (l0.min(r0), l1.max(r1))
             };
             assert!(lo.cmple(clo).all() && hi.cmpge(chi).all(), "node {i} does not hold its children");
             (lo, hi)
         }
-        walk(&bvh, 0, &mut seen);
+        walk(&bvh, &pos, 0, &mut seen);
         assert!(seen.iter().all(|&s| s == 1));
     }
 
@@ -277,7 +305,7 @@ mod tests {
     #[test]
     fn duplicates_split_by_count() {
         let t = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
-        let bvh = Bvh::build(&vec![t; 1000]);
+        let (bvh, _) = soup(&vec![t; 1000]);
         assert!(bvh.nodes.iter().all(|n| n.n as usize <= MAX_LEAF * 2));
         assert_eq!(bvh.nodes.iter().map(|n| n.n as usize).sum::<usize>(), 1000);
     }

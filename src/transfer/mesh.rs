@@ -9,10 +9,10 @@
 //! normalised per vertex, and `w` negated on a mirroring node.
 
 use crate::error::{Error, Result};
-use crate::format::raw::read_raw;
+use crate::format::raw::{read_raw, RawMesh};
 use crate::scene::nodes::{instances, Instance};
 use crate::scene::to_triangle_list;
-use crate::scene::{smooth_normals, PrimRef, ReadOptions, Scene, Slot};
+use crate::scene::{smooth_vertex_normals, PrimRef, ReadOptions, Scene, Slot};
 use glam::{DVec3, Mat3, Mat4, Vec3, Vec3A};
 use std::path::Path;
 
@@ -36,12 +36,64 @@ pub struct Low {
     pub diagonal: f64,
 }
 
-/// HIGH: triangles (corners in the local frame) and smooth per-vertex normals (world space).
+/// HIGH, held once: positions in the local frame, indexed triangles, unit normals (world
+/// space). About 50 bytes a triangle for a closed mesh whose normals follow its positions.
 #[derive(Debug, Default)]
 pub struct High {
-    pub corners: Vec<[Vec3A; 3]>,
-    pub normals: Vec<Vec3A>,
-    pub normal_index: Vec<[u32; 3]>,
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    /// Per triangle, indices into `normals`; `None` when those are `triangles` (one normal per
+    /// position, as most files store them).
+    pub normal_triangles: Option<Vec<[u32; 3]>>,
+}
+
+impl High {
+    /// Appends a mesh as read, moving its positions into the frame centred on `origin`; smooth
+    /// normals where it has none, per part (each part's primitive has its own vertices). Its
+    /// arrays are taken over, not copied, when HIGH is empty.
+    fn append(&mut self, raw: RawMesh, origin: DVec3) {
+        let (mut normal_triangles, mut normals) = (raw.normal_triangles, raw.normals);
+        let (mut positions, triangles) = (raw.positions, raw.triangles);
+        // RawMesh normals are unit already; only a HIGH without any gets smooth ones, per part.
+        if normals.is_empty() {
+            normal_triangles = Vec::with_capacity(triangles.len());
+            for k in 0..raw.parts.len().max(1) {
+                let r =
+                    if raw.parts.is_empty() { 0..triangles.len() } else { part_range(&raw.parts, k, triangles.len()) };
+                let tris = &triangles[r];
+                let Some(lo) = tris.iter().flatten().min().copied() else { continue };
+                let hi = tris.iter().flatten().max().copied().unwrap_or(lo);
+                let shifted: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|i| i - lo)).collect();
+                let b = normals.len() as u32;
+                normals.extend(smooth_vertex_normals(&positions[lo as usize..=hi as usize], &shifted));
+                normal_triangles.extend(shifted.iter().map(|t| t.map(|i| i + b)));
+            }
+        }
+        let shared = normal_triangles == triangles;
+        positions.iter_mut().for_each(|p| *p = local(dvec(*p), origin).to_array());
+        let (base_p, base_n) = (self.positions.len() as u32, self.normals.len() as u32);
+        if shared && self.normal_triangles.is_none() && base_p == base_n {
+            drop(normal_triangles);
+        } else {
+            let nt = self.normal_triangles.get_or_insert_with(|| self.triangles.clone());
+            nt.extend(normal_triangles.iter().map(|t| t.map(|i| i + base_n)));
+        }
+        if self.positions.is_empty() {
+            self.triangles = triangles;
+            self.positions = positions;
+            self.normals = normals;
+        } else {
+            self.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base_p)));
+            self.positions.extend(positions);
+            self.normals.extend(normals);
+        }
+    }
+}
+
+fn part_range(parts: &[crate::format::raw::Part], k: usize, n: usize) -> std::ops::Range<usize> {
+    let end = parts.get(k + 1).map_or(n, |p| p.start as usize);
+    parts[k].start as usize..end
 }
 
 /// A named run of HIGH triangles, from one file.
@@ -219,43 +271,27 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
     Ok(out)
 }
 
-/// Reads every HIGH file in world space; returns the triangles, each file's triangle count and
-/// the named parts (consecutive runs with one name).
+/// Reads every HIGH file in world space (`given`, when there is one, stands for the first);
+/// returns the triangles, each file's triangle count and the named parts (consecutive runs with
+/// one name).
 pub fn high(
     paths: &[std::path::PathBuf],
     read: &ReadOptions,
     origin: DVec3,
+    mut given: Option<RawMesh>,
 ) -> Result<(High, Vec<usize>, Vec<HighPart>)> {
     let mut h = High::default();
     let mut counts = Vec::new();
     let mut parts: Vec<HighPart> = Vec::new();
     for (f, path) in paths.iter().enumerate() {
-        let raw = read_raw(path, read)?;
+        let raw = match given.take() {
+            Some(m) => m,
+            None => read_raw(path, read)?,
+        };
         if raw.triangles.is_empty() {
             return Err(Error::input(path, "has no triangles to bake from (HIGH must be a triangle mesh)"));
         }
-        let base_tri = h.corners.len() as u32;
-        let base_n = h.normals.len() as u32;
-        if raw.normals.is_empty() {
-            // Smooth normals per part, as each part's primitive has its own vertices.
-            for k in 0..raw.parts.len() {
-                let r = raw.part_range(k);
-                let tris = &raw.triangles[r];
-                let Some(lo) = tris.iter().flatten().min().copied() else { continue };
-                let hi = tris.iter().flatten().max().copied().unwrap_or(lo);
-                let pos = &raw.positions[lo as usize..=hi as usize];
-                let idx: Vec<u32> = tris.iter().flatten().map(|i| i - lo).collect();
-                let (n, _) = smooth_normals(pos.as_flattened(), &idx);
-                let b = h.normals.len() as u32;
-                h.normals.extend(n.into_iter().map(Vec3A::from));
-                h.normal_index.extend(tris.iter().map(|t| t.map(|i| b + i - lo)));
-            }
-        } else {
-            // Already unit (normalised once, after the normal matrix).
-            h.normals.extend(raw.normals.iter().map(|&v| Vec3A::from(v)));
-            h.normal_index.extend(raw.normal_triangles.iter().map(|t| t.map(|i| base_n + i)));
-        }
-        h.corners.extend(raw.triangles.iter().map(|t| t.map(|i| local(dvec(raw.positions[i as usize]), origin))));
+        let base_tri = h.triangles.len() as u32;
         for (k, p) in raw.parts.iter().enumerate() {
             let r = raw.part_range(k);
             let (start, end) = (base_tri + r.start as u32, base_tri + r.end as u32);
@@ -265,6 +301,7 @@ pub fn high(
             }
         }
         counts.push(raw.triangles.len());
+        h.append(raw, origin);
     }
     Ok((h, counts, parts))
 }

@@ -18,6 +18,7 @@ pub mod raycast;
 pub mod report;
 
 use crate::error::{Error, Result};
+use crate::format::raw::RawMesh;
 use crate::normalmap::Convention;
 use crate::progress::Reporter;
 use crate::report::Timings;
@@ -62,7 +63,13 @@ pub struct Settings {
     pub matching: Match,
     /// The node to bake a LOW mesh shown by several nodes through.
     pub node: Option<String>,
+    /// HIGH already in memory, standing for the first of `highs` and taken by the first bake:
+    /// how the bench bakes meshes too large to write and read at every run.
+    pub given: Option<GivenHigh>,
 }
+
+/// A mesh handed to one bake.
+pub type GivenHigh = std::sync::Arc<std::sync::Mutex<Option<RawMesh>>>;
 
 impl Default for Settings {
     fn default() -> Self {
@@ -84,6 +91,7 @@ impl Default for Settings {
             progress: Reporter::none(),
             matching: Match::Auto,
             node: None,
+            given: None,
         }
     }
 }
@@ -128,28 +136,40 @@ pub fn material_prims(scene: &Scene, m: usize) -> Vec<PrimRef> {
         .collect()
 }
 
-/// HIGH's triangles grouped for the rays of each LOW part: one BVH per set of HIGH parts.
+/// HIGH's triangles grouped for the rays of each LOW part: one BVH per set of HIGH parts, all
+/// over HIGH's one array of positions.
 struct Sets {
+    positions: Vec<[f32; 3]>,
     bvhs: Vec<bvh::Bvh>,
     /// Per set, the HIGH triangle of each BVH id (`None`: the ids are HIGH's own).
     ids: Vec<Option<Vec<u32>>>,
 }
 
-fn build_sets(corners: &[[Vec3A; 3]], parts: &[mesh::HighPart], sets: &[Vec<usize>]) -> Sets {
-    let (mut bvhs, mut ids) = (Vec::new(), Vec::new());
-    for set in sets {
+fn build_sets(
+    positions: Vec<[f32; 3]>,
+    mut triangles: Vec<[u32; 3]>,
+    parts: &[mesh::HighPart],
+    sets: &[Vec<usize>],
+) -> Sets {
+    let mut bvhs: Vec<Option<bvh::Bvh>> = sets.iter().map(|_| None).collect();
+    let mut ids = Vec::new();
+    for (k, set) in sets.iter().enumerate() {
         if set.len() == parts.len() {
-            // Every HIGH part: the tree over HIGH as read, with no copy.
-            bvhs.push(bvh::Bvh::build(corners));
             ids.push(None);
             continue;
         }
         let tris: Vec<u32> = set.iter().flat_map(|&k| parts[k].start..parts[k].end).collect();
-        let sub: Vec<[Vec3A; 3]> = tris.iter().map(|&t| corners[t as usize]).collect();
-        bvhs.push(bvh::Bvh::build(&sub));
+        let sub: Vec<[u32; 3]> = tris.iter().map(|&t| triangles[t as usize]).collect();
+        bvhs[k] = Some(bvh::Bvh::build(&positions, sub));
         ids.push(Some(tris));
     }
-    Sets { bvhs, ids }
+    // Every HIGH part: the tree takes HIGH's triangles over (permuted into leaf order), no copy.
+    for (k, set) in sets.iter().enumerate() {
+        if set.len() == parts.len() {
+            bvhs[k] = Some(bvh::Bvh::build(&positions, std::mem::take(&mut triangles)));
+        }
+    }
+    Sets { positions, bvhs: bvhs.into_iter().map(|b| b.expect("every set built")).collect(), ids }
 }
 
 /// Bakes HIGH into LOW: one map per material in `materials`, over the triangle primitives that
@@ -165,14 +185,19 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
     }
     let (low_names, low_part) = mesh::low_parts(&placed);
     let (origin, diagonal) = mesh::frame(scene, &placed)?;
-    let (high, counts, high_parts) = t.time("read high", || mesh::high(&s.highs, &s.read, origin))?;
+    let given = s.given.as_ref().and_then(|g| g.lock().ok().and_then(|mut m| m.take()));
+    let (high, counts, high_parts) = t.time("read high", || mesh::high(&s.highs, &s.read, origin, given))?;
     crate::report::mem_mark("transfer read");
     let high_names: Vec<String> = high_parts.iter().map(|p| p.name.clone()).collect();
     let groups = parts::group(&low_names, &high_names, s.matching);
-    let High { corners, normals, normal_index } = high;
-    let sets = t.time("bvh", || build_sets(&corners, &high_parts, &groups.sets));
-    drop(corners);
+    let High { positions, triangles, normals, normal_triangles } = high;
+    let sets = t.time("bvh", || build_sets(positions, triangles, &high_parts, &groups.sets));
     crate::report::mem_mark("transfer bvh");
+    let high_bytes = sets.positions.capacity() * 12
+        + sets.bvhs.iter().map(|b| b.bytes()).sum::<usize>()
+        + sets.ids.iter().flatten().map(|v| v.capacity() * 4).sum::<usize>()
+        + normals.capacity() * 12
+        + normal_triangles.as_ref().map_or(0, |n| n.capacity() * 12);
     let front = s.ray_front.unwrap_or(DEFAULT_REACH * diagonal);
     let back = s.ray_back.unwrap_or(DEFAULT_REACH * diagonal);
     let labels = files::unique_labels(scene, materials);
@@ -197,7 +222,7 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
             low_set: &groups.low_set,
             parts: low_names.len(),
             normals: &normals,
-            normal_index: &normal_index,
+            normal_triangles: normal_triangles.as_deref(),
             front,
             back,
         };
@@ -249,6 +274,7 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
         counts: counts_all,
         height_range,
         bvh_nodes: sets.bvhs.iter().map(|b| b.nodes.len()).sum(),
+        high_bytes,
         matching: if s.matching == Match::Auto { "auto" } else { "none" }.to_string(),
         pairs: groups
             .pairs
@@ -304,8 +330,9 @@ struct Ctx<'a> {
     /// Per LOW part, the set of HIGH parts its rays meet.
     low_set: &'a [usize],
     parts: usize,
-    normals: &'a [Vec3A],
-    normal_index: &'a [[u32; 3]],
+    normals: &'a [[f32; 3]],
+    /// `None`: normals follow the positions' indices.
+    normal_triangles: Option<&'a [[u32; 3]]>,
     front: f64,
     back: f64,
 }
@@ -474,16 +501,18 @@ impl Ctx<'_> {
             None => (nhat, self.front as f32, self.back as f32),
         };
         let set = self.low_set[low.tri_part[t] as usize];
-        let Some(hit) = raycast::nearest(&self.sets.bvhs[set], &raycast::Ray::new(p, dir), back, front) else {
+        let tree = &self.sets.bvhs[set];
+        let Some(hit) = raycast::nearest(tree, &self.sets.positions, &raycast::Ray::new(p, dir), back, front) else {
             c.missed_rays += 1;
             return flat;
         };
         let id = self.sets.ids[set].as_ref().map_or(hit.id, |v| v[hit.id as usize]);
-        let ni = self.normal_index[id as usize];
-        let hn = (self.normals[ni[0] as usize] * hit.bary[0]
-            + self.normals[ni[1] as usize] * hit.bary[1]
-            + self.normals[ni[2] as usize] * hit.bary[2])
-            .normalize_or_zero();
+        let ni = match self.normal_triangles {
+            Some(nt) => nt[id as usize],
+            None => tree.tris[hit.slot as usize],
+        };
+        let n = |k: usize| Vec3A::from(self.normals[ni[k] as usize]) * hit.bary[k];
+        let hn = (n(0) + n(1) + n(2)).normalize_or_zero();
         let bit = nrm.cross(tan) * sign;
         let m = Mat3A::from_cols(tan, bit, nrm);
         let det = m.determinant();

@@ -5,7 +5,7 @@
 //! and rays through mesh vertices do not slip through HIGH. Edge values that come out exactly
 //! zero in f32 are recomputed in f64, as the paper advises. Degenerate triangles never hit.
 
-use super::bvh::{Bvh, Tri};
+use super::bvh::Bvh;
 use glam::Vec3A;
 
 /// A ray prepared for the watertight test (its shear is computed once).
@@ -45,6 +45,8 @@ pub struct Hit {
     pub t: f32,
     /// The triangle's index in the input.
     pub id: u32,
+    /// Its index in the tree's leaf order (into [`Bvh::tris`]).
+    pub slot: u32,
     /// Barycentric weights of the triangle's three corners.
     pub bary: [f32; 3],
 }
@@ -60,12 +62,12 @@ impl Hit {
 
 /// The watertight test; hits from both sides count.
 #[inline]
-pub fn intersect(ray: &Ray, tri: &Tri) -> Option<(f32, [f32; 3])> {
+pub fn intersect(ray: &Ray, v: &[Vec3A; 3]) -> Option<(f32, [f32; 3])> {
     let [kx, ky, kz] = ray.k;
     let [sx, sy, sz] = ray.shear;
-    let a = tri.v[0] - ray.origin;
-    let b = tri.v[1] - ray.origin;
-    let c = tri.v[2] - ray.origin;
+    let a = v[0] - ray.origin;
+    let b = v[1] - ray.origin;
+    let c = v[2] - ray.origin;
     let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
     let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
     let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
@@ -114,7 +116,7 @@ fn gap(a: f32, b: f32) -> f32 {
 }
 
 /// The hit nearest the ray's origin with `t` in `[-back, front]`.
-pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
+pub fn nearest(bvh: &Bvh, positions: &[[f32; 3]], ray: &Ray, back: f32, front: f32) -> Option<Hit> {
     if bvh.is_empty() {
         return None;
     }
@@ -130,12 +132,12 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
     loop {
         let n = &bvh.nodes[node];
         if n.n > 0 {
-            for tri in &bvh.tris[n.a as usize..(n.a + n.n) as usize] {
-                if let Some((t, bary)) = intersect(ray, tri) {
+            for k in n.a as usize..(n.a + n.n) as usize {
+                if let Some((t, bary)) = intersect(ray, &bvh.corners(positions, k)) {
                     if t < lo || t > hi {
                         continue;
                     }
-                    let h = Hit { t, id: tri.id, bary };
+                    let h = Hit { t, id: bvh.ids[k], slot: k as u32, bary };
                     if best.as_ref().map(|b| h.better_than(b)).unwrap_or(true) {
                         best = Some(h);
                         // Nothing farther than this hit can win; equal distances still can
@@ -189,8 +191,8 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32) -> Option<Hit> {
 mod tests {
     use super::*;
 
-    fn tri(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> Tri {
-        Tri { v: [a.into(), b.into(), c.into()], id: 0 }
+    fn tri(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [Vec3A; 3] {
+        [a.into(), b.into(), c.into()]
     }
 
     #[test]
@@ -232,11 +234,11 @@ mod tests {
     fn nearest_on_either_side() {
         let sheet = |z: f32| [Vec3A::new(-1.0, -1.0, z), Vec3A::new(1.0, -1.0, z), Vec3A::new(0.0, 1.0, z)];
         let tris: Vec<[Vec3A; 3]> = [0.5f32, -0.2, 0.9, -0.7].iter().map(|&z| sheet(z)).collect();
-        let bvh = Bvh::build(&tris);
+        let (bvh, pos) = crate::transfer::bvh::tests::soup(&tris);
         let r = Ray::new(Vec3A::ZERO, Vec3A::Z);
-        let h = nearest(&bvh, &r, 1.0, 1.0).unwrap();
+        let h = nearest(&bvh, &pos, &r, 1.0, 1.0).unwrap();
         assert_eq!((h.id, h.t), (1, -0.2));
-        assert_eq!(nearest(&bvh, &r, 0.1, 0.6).unwrap().id, 0);
-        assert!(nearest(&bvh, &r, 0.1, 0.4).is_none());
+        assert_eq!(nearest(&bvh, &pos, &r, 0.1, 0.6).unwrap().id, 0);
+        assert!(nearest(&bvh, &pos, &r, 0.1, 0.4).is_none());
     }
 }

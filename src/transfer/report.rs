@@ -125,6 +125,8 @@ pub struct TransferReport {
     /// Signed distance from LOW to HIGH along the rays (world units), over all hits.
     pub height_range: Option<[f32; 2]>,
     pub bvh_nodes: usize,
+    /// Bytes HIGH takes while rays are cast (trees, positions, triangles, normals).
+    pub high_bytes: usize,
     /// `auto` or `none`.
     pub matching: String,
     pub pairs: Vec<Pair>,

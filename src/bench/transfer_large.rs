@@ -1,0 +1,292 @@
+//! `bench transfer`'s production-scale rows: `bake --from` with a HIGH of 10 to 50 million
+//! triangles (the bench's displaced torus, finer), generated in memory or read from the OBJ and
+//! binary PLY files the bench writes, onto the same LOW at 2048²: stage times, peak memory and
+//! bytes per HIGH triangle.
+
+use super::transfer::{evaluate, time_one, Evaluation, Torus};
+use crate::error::{Error, Result};
+use crate::format::raw::RawMesh;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::f64::consts::TAU;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Where a large row's HIGH comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Source {
+    /// Generated in the bench's own process and handed to the baker: no reader.
+    Memory,
+    Obj,
+    Ply,
+}
+
+impl Source {
+    pub fn parse(s: &str) -> Option<Source> {
+        match s.trim() {
+            "memory" => Some(Source::Memory),
+            "obj" => Some(Source::Obj),
+            "ply" => Some(Source::Ply),
+            _ => None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct LargeRow {
+    pub high_triangles: usize,
+    pub source: Source,
+    pub size: usize,
+    /// The HIGH file's size (0 in memory).
+    pub file_mb: f64,
+    /// The bake, from reading HIGH to the written OUT (for memory rows: in the bench's process).
+    pub wall_s: f64,
+    pub read_high_ms: f64,
+    pub bvh_ms: f64,
+    pub rays_ms: f64,
+    /// Peak resident memory of the bake, all included.
+    pub peak_mb: f64,
+    pub bytes_per_triangle: f64,
+    /// What the baker's HIGH (tree, positions, triangles, normals) takes alone, per triangle.
+    pub high_bytes_per_triangle: f64,
+    pub error: Evaluation,
+}
+
+/// The tessellation with about `millions` million triangles, the ring twice the tube's count.
+pub fn tessellation(millions: f64) -> (usize, usize) {
+    let quads = millions * 1e6 / 2.0;
+    let n_ph = (quads / 2.0).sqrt().round().max(1.0) as usize;
+    (2 * n_ph, n_ph)
+}
+
+impl Torus {
+    /// HIGH as [`Torus::high`] makes it, straight into the baker's form, built in parallel.
+    pub fn high_raw(&self, n_th: usize, n_ph: usize) -> RawMesh {
+        let vn: Vec<([f32; 3], [f32; 3])> = (0..n_th * n_ph)
+            .into_par_iter()
+            .map(|k| {
+                let (i, j) = (k % n_th, k / n_th);
+                let (p, n) = self.point_normal(TAU * i as f64 / n_th as f64, TAU * j as f64 / n_ph as f64);
+                (p.as_vec3().to_array(), n.as_vec3().to_array())
+            })
+            .collect();
+        let (positions, normals) = vn.into_iter().unzip();
+        let triangles: Vec<[u32; 3]> = (0..n_th * n_ph)
+            .into_par_iter()
+            .flat_map_iter(|k| {
+                let (i, j) = (k % n_th, k / n_th);
+                let v = |i: usize, j: usize| ((j % n_ph) * n_th + (i % n_th)) as u32;
+                let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+                [[a, b, c], [a, c, d]]
+            })
+            .collect();
+        let parts = vec![crate::format::raw::Part { name: "torus".into(), material: None, start: 0 }];
+        RawMesh { positions, normals, normal_triangles: triangles.clone(), triangles, parts, ..Default::default() }
+    }
+}
+
+/// Writes `m` as OBJ (`v`, `vn`, `f a//a b//b c//c`), formatted in parallel blocks.
+pub fn write_obj(m: &RawMesh, path: &Path) -> Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| Error::output(path, e))?);
+    let io = |e| Error::output(path, e);
+    const BLOCK: usize = 1 << 16;
+    for chunk in m.positions.chunks(BLOCK * 16).enumerate() {
+        let (c, ps) = chunk;
+        let base = c * BLOCK * 16;
+        let text: Vec<Vec<u8>> = ps
+            .par_chunks(BLOCK)
+            .enumerate()
+            .map(|(b, block)| {
+                let mut s = Vec::with_capacity(block.len() * 80);
+                for (k, p) in block.iter().enumerate() {
+                    let n = m.normals[base + b * BLOCK + k];
+                    let _ = writeln!(s, "v {} {} {}\nvn {} {} {}", p[0], p[1], p[2], n[0], n[1], n[2]);
+                }
+                s
+            })
+            .collect();
+        text.iter().try_for_each(|t| f.write_all(t)).map_err(io)?;
+    }
+    for ts in m.triangles.chunks(BLOCK * 16) {
+        let text: Vec<Vec<u8>> = ts
+            .par_chunks(BLOCK)
+            .map(|block| {
+                let mut s = Vec::with_capacity(block.len() * 40);
+                for t in block {
+                    let [a, b, c] = t.map(|i| i + 1);
+                    let _ = writeln!(s, "f {a}//{a} {b}//{b} {c}//{c}");
+                }
+                s
+            })
+            .collect();
+        text.iter().try_for_each(|t| f.write_all(t)).map_err(io)?;
+    }
+    f.flush().map_err(io)
+}
+
+/// Writes `m` as binary little-endian PLY: float x/y/z/nx/ny/nz, `uchar int` face lists.
+pub fn write_ply(m: &RawMesh, path: &Path) -> Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| Error::output(path, e))?);
+    let io = |e| Error::output(path, e);
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment bumpbake bench\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        m.positions.len(),
+        m.triangles.len()
+    );
+    f.write_all(header.as_bytes()).map_err(io)?;
+    for (p, n) in m.positions.iter().zip(&m.normals) {
+        for c in p.iter().chain(n) {
+            f.write_all(&c.to_le_bytes()).map_err(io)?;
+        }
+    }
+    for t in &m.triangles {
+        f.write_all(&[3]).map_err(io)?;
+        for i in t {
+            f.write_all(&i.to_le_bytes()).map_err(io)?;
+        }
+    }
+    f.flush().map_err(io)
+}
+
+/// Peak resident memory since the last [`reset_peak`], bytes (Linux; 0 elsewhere).
+fn peak_bytes() -> u64 {
+    let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let kb = s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)?.parse().ok());
+    kb.unwrap_or(0u64) * 1024
+}
+
+/// Starts a new peak at the current resident size (Linux's `clear_refs`).
+fn reset_peak() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// Bakes the LOW at `low` from HIGH generated in this process, as `bake` does, and measures it.
+fn bake_in_memory(low: &Path, out: &Path, mesh: RawMesh, size: usize) -> Result<(crate::bake::BakeReport, f64, u64)> {
+    use crate::transfer::Settings;
+    let given = std::sync::Arc::new(std::sync::Mutex::new(Some(mesh)));
+    let job = crate::bake::BakeJob {
+        mesh: low.to_path_buf(),
+        output: out.to_path_buf(),
+        map: crate::bake::MapSource::Transfer(Box::new(Settings {
+            highs: vec![PathBuf::from("(generated)")],
+            width: size,
+            height: size,
+            given: Some(given),
+            ..Default::default()
+        })),
+        ..Default::default()
+    };
+    // The generated mesh is HIGH as a reader would hand it over: it counts in the peak.
+    reset_peak();
+    let t = std::time::Instant::now();
+    let r = crate::bake::run(&job)?;
+    Ok((r, t.elapsed().as_secs_f64(), peak_bytes()))
+}
+
+/// One large row: HIGH of `n_th x n_ph` quads from `source`, LOW at `low`, a `size`² map.
+pub fn large_row(
+    exe: &Path,
+    dir: &Path,
+    low: &Path,
+    (n_th, n_ph): (usize, usize),
+    source: Source,
+    size: usize,
+) -> Result<LargeRow> {
+    let torus = Torus::default();
+    let tris = 2 * n_th * n_ph;
+    let mesh = torus.high_raw(n_th, n_ph);
+    let reach = 0.05 * 2.0 * (torus.major + torus.minor);
+    let truth = |p: DVec3, d: DVec3| torus.truth(p, d, reach);
+    let row = |file_mb, wall_s, stages: [f64; 3], peak: u64, high_bytes: f64, error| LargeRow {
+        high_triangles: tris,
+        source,
+        size,
+        file_mb,
+        wall_s,
+        read_high_ms: stages[0],
+        bvh_ms: stages[1],
+        rays_ms: stages[2],
+        peak_mb: peak as f64 / 1e6,
+        bytes_per_triangle: peak as f64 / tris as f64,
+        high_bytes_per_triangle: high_bytes / tris as f64,
+        error,
+    };
+    if source == Source::Memory {
+        let out = dir.join(format!("out_mem_{tris}.glb"));
+        let (r, wall, peak) = bake_in_memory(low, &out, mesh, size)?;
+        let tr = r.transfer.ok_or_else(|| Error::usage("bench transfer: the bake made no transfer report"))?;
+        let stage = |n: &str| tr.timings_ms.stages.iter().find(|s| s.0 == n).map_or(f64::NAN, |s| s.1);
+        let error = evaluate(&out, &truth, &|_| true)?;
+        let _ = std::fs::remove_file(&out);
+        let stages = [stage("read high"), stage("bvh"), stage("rays")];
+        return Ok(row(0.0, wall, stages, peak, tr.high_bytes as f64, error));
+    }
+    let path = dir.join(format!("high_{tris}.{}", if source == Source::Obj { "obj" } else { "ply" }));
+    match source {
+        Source::Obj => write_obj(&mesh, &path)?,
+        _ => write_ply(&mesh, &path)?,
+    }
+    drop(mesh);
+    let file_mb = std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6);
+    let r = time_one(exe, dir, low, &path, tris, size, 1, 1, &torus);
+    let _ = std::fs::remove_file(&path);
+    let r = r?;
+    let stages = [r.read_high_ms, r.bvh_ms, r.rays_ms];
+    let high_bytes = r.high_bytes_per_triangle * tris as f64;
+    Ok(row(file_mb, r.median_s, stages, (r.peak_mb * 1e6) as u64, high_bytes, r.error))
+}
+
+/// The large rows as a text table.
+pub fn table(rows: &[LargeRow]) -> String {
+    let mut s = String::from(
+        "HIGH tris  from     file MB  size  wall s  read ms  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°\n",
+    );
+    for r in rows {
+        s += &format!(
+            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>8.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}\n",
+            r.high_triangles,
+            format!("{:?}", r.source).to_lowercase(),
+            r.file_mb,
+            r.size,
+            r.wall_s,
+            r.read_high_ms,
+            r.bvh_ms,
+            r.rays_ms,
+            r.peak_mb,
+            r.bytes_per_triangle,
+            r.high_bytes_per_triangle,
+            r.error.synced.mean,
+            r.error.synced.p99
+        );
+    }
+    s
+}
+
+/// Which large rows to run.
+#[derive(Debug, Clone, Default)]
+pub struct Plan {
+    /// HIGH sizes, millions of triangles.
+    pub millions: Vec<f64>,
+    pub sources: Vec<Source>,
+    pub size: usize,
+}
+
+/// Every row of `plan`, with the bench's LOW written into `dir`.
+pub fn run(exe: &Path, dir: &Path, plan: &Plan, mut progress: impl FnMut(&LargeRow)) -> Result<Vec<LargeRow>> {
+    let mut rows = Vec::new();
+    if plan.millions.is_empty() || plan.sources.is_empty() {
+        return Ok(rows);
+    }
+    std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, e))?;
+    let low = dir.join("low.glb");
+    std::fs::write(&low, Torus::default().low(48, 24).glb()).map_err(|e| Error::output(&low, e))?;
+    for &m in &plan.millions {
+        for &source in &plan.sources {
+            let r = large_row(exe, dir, &low, tessellation(m), source, plan.size)?;
+            progress(&r);
+            rows.push(r);
+        }
+    }
+    Ok(rows)
+}
