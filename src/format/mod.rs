@@ -30,12 +30,7 @@ impl Scene {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
         if ext == "obj" {
             // Streamed: the text is never held whole next to what is parsed from it.
-            let name = path.file_name().map(|n| n.to_string_lossy()).unwrap_or_default();
-            let size = std::fs::metadata(path).map_or(0, |m| m.len());
-            opts.progress.start(&format!("read {name}"), size, "bytes");
-            let scene = obj::read_file(path, opts);
-            opts.progress.finish();
-            return scene;
+            return obj::read_file(path, opts);
         }
         let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
         if ext != "obj" && bytes.starts_with(b"glTF") {
@@ -50,11 +45,7 @@ impl Scene {
     pub fn read_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
         if ext == "obj" {
-            let name = path.file_name().map(|n| n.to_string_lossy()).unwrap_or_default();
-            opts.progress.start(&format!("read {name}"), bytes.len() as u64, "bytes");
-            let scene = obj::read(path, bytes, opts);
-            opts.progress.finish();
-            scene
+            obj::read(path, bytes, opts)
         } else if ext == "ply" || ply::is_ply(bytes) {
             obj::ply_scene(path, ply::parse(path, bytes)?, opts)
         } else if bytes.starts_with(b"glTF") || ext == "glb" {

@@ -17,12 +17,12 @@ use std::path::Path;
 
 /// Reads the OBJ file at `path`, streaming it through the parallel parser.
 pub fn read_file(path: &Path, opts: &ReadOptions) -> Result<Scene> {
-    let data = obj_parse::parse_file(path)?;
+    let data = obj_parse::parse_file(path, &opts.progress)?;
     build_scene(path, data, opts)
 }
 
 pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
-    let data = obj_parse::parse_bytes(path, bytes)?;
+    let data = obj_parse::parse_bytes(path, bytes, &opts.progress)?;
     build_scene(path, data, opts)
 }
 

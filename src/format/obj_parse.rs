@@ -12,6 +12,7 @@
 //! `raw.rs` (a RawMesh) converts. Polygons are fanned from their first corner, as `tobj` did.
 
 use crate::error::{Error, Result};
+use crate::progress::{Counting, Reporter};
 use memchr::memchr;
 use rayon::prelude::*;
 use std::io::Read;
@@ -52,15 +53,30 @@ pub struct ObjData {
     pub mtllibs: Vec<String>,
 }
 
-/// Reads and parses the OBJ file at `path`, a block at a time.
-pub fn parse_file(path: &Path) -> Result<ObjData> {
+/// Reads and parses the OBJ file at `path`, a block at a time, reporting the bytes read as the
+/// progress stage `read NAME`.
+pub fn parse_file(path: &Path, progress: &Reporter) -> Result<ObjData> {
     let file = std::fs::File::open(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
-    parse_reader(path, file, PIECE)
+    let len = file.metadata().map_or(0, |m| m.len());
+    reported(path, len, progress, |p| parse_reader(path, Counting::new(file, p), PIECE))
 }
 
-/// Parses OBJ bytes already in memory.
-pub fn parse_bytes(path: &Path, bytes: &[u8]) -> Result<ObjData> {
-    parse_reader(path, bytes, PIECE)
+/// Parses OBJ bytes already in memory, reported as [`parse_file`] reports a file.
+pub fn parse_bytes(path: &Path, bytes: &[u8], progress: &Reporter) -> Result<ObjData> {
+    reported(path, bytes.len() as u64, progress, |p| parse_reader(path, Counting::new(bytes, p), PIECE))
+}
+
+fn reported(
+    path: &Path,
+    len: u64,
+    progress: &Reporter,
+    read: impl FnOnce(&Reporter) -> Result<ObjData>,
+) -> Result<ObjData> {
+    let name = path.file_name().map(|n| n.to_string_lossy()).unwrap_or_default();
+    progress.start(&format!("read {name}"), len, "bytes");
+    let out = read(progress);
+    progress.finish();
+    out
 }
 
 /// Parses from `r` with pieces of about `piece` bytes (small in tests, to cut lines everywhere).

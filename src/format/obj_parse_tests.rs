@@ -1,11 +1,11 @@
 use super::*;
 
 fn parse(s: &str) -> ObjData {
-    parse_bytes(Path::new("t.obj"), s.as_bytes()).unwrap()
+    parse_bytes(Path::new("t.obj"), s.as_bytes(), &Default::default()).unwrap()
 }
 
 fn error(s: &str) -> String {
-    parse_bytes(Path::new("t.obj"), s.as_bytes()).unwrap_err().to_string()
+    parse_bytes(Path::new("t.obj"), s.as_bytes(), &Default::default()).unwrap_err().to_string()
 }
 
 #[test]

@@ -13,7 +13,7 @@ fn tobj_models(path: &Path, bytes: &[u8]) -> Vec<tobj::Model> {
 }
 
 fn ours(path: &Path, bytes: &[u8]) -> Vec<(String, Option<usize>, Model)> {
-    let data = obj_parse::parse_bytes(path, bytes).unwrap();
+    let data = obj_parse::parse_bytes(path, bytes, &Default::default()).unwrap();
     let (_, ids, _) = load_materials(path, path.parent().unwrap(), &data.mtllibs, &ReadOptions::default()).unwrap();
     let mut remap = Remaps::new(&data);
     runs(&data, &ids).into_iter().map(|r| (r.name.clone(), r.material, remap.model(&data, r.tris))).collect()

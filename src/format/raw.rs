@@ -55,11 +55,11 @@ impl RawMesh {
 /// in world space, one part per node (named after the node, else its mesh).
 ///
 /// OBJ and PLY take a fast path: the parsed arrays become the mesh as they are, with no Scene,
-/// no welding and no per-corner copies; `opts` matters only to glTF.
+/// no welding and no per-corner copies; of `opts`, OBJ uses only the progress reporter.
 pub fn read_raw(path: &Path, opts: &ReadOptions) -> Result<RawMesh> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
-        "obj" => from_obj(path, super::obj_parse::parse_file(path)?),
+        "obj" => from_obj(path, super::obj_parse::parse_file(path, &opts.progress)?),
         "ply" => from_ply(path, super::ply::read_file(path)?),
         _ => from_scene(&Scene::read(path, opts)?),
     }
