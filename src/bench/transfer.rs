@@ -487,12 +487,14 @@ fn describe(t: &Torus) -> String {
     format!("R {} r {} displaced by {}·(sin 8θ sin 4φ + ½ cos(3θ+6φ)); LOW 48x24 quads", t.major, t.minor, t.amp)
 }
 
-/// The whole bench: `quality` lists `(size, samples)` pairs run on the 600k-triangle HIGH.
+/// The whole bench: `quality` lists `(size, samples)` pairs run on the 600k-triangle HIGH; `keep`
+/// leaves the cases in `dir`.
 pub fn run(
     exe: &Path,
     dir: &Path,
     quality: &[(usize, usize)],
     runs: usize,
+    keep: bool,
     mut progress: impl FnMut(&Row),
 ) -> Result<Report> {
     let torus = Torus::default();
@@ -511,7 +513,9 @@ pub fn run(
         let r = time_one(exe, dir, &low, &high, tris, 1024, 1, runs, &torus)?;
         progress(&r);
         scaling.push(r);
-        let _ = std::fs::remove_file(&high);
+        if !keep {
+            let _ = std::fs::remove_file(&high);
+        }
     }
     Ok(Report {
         torus: describe(&torus),

@@ -40,9 +40,15 @@ pub struct LargeRow {
     pub size: usize,
     /// The HIGH file's size (0 in memory).
     pub file_mb: f64,
-    /// The bake, from reading HIGH to the written OUT (for memory rows: in the bench's process).
+    /// The bake, from reading HIGH to the written OUT (for memory rows: in the bench's process);
+    /// NaN when only the reader was timed.
     pub wall_s: f64,
+    /// CPU time of the bake (user and system, every thread), seconds: the machine's other load
+    /// does not inflate it as it does the wall time.
+    pub cpu_s: f64,
     pub read_high_ms: f64,
+    /// The file's size over the bake's read stage (0 in memory).
+    pub read_mb_s: f64,
     pub bvh_ms: f64,
     pub rays_ms: f64,
     /// Peak resident memory of the bake, all included.
@@ -51,6 +57,20 @@ pub struct LargeRow {
     /// What the baker's HIGH (tree, positions, triangles, normals) takes alone, per triangle.
     pub high_bytes_per_triangle: f64,
     pub error: Evaluation,
+    /// The reader alone (`format::raw::read_raw` in the bench's process), for file rows.
+    pub reader: Option<ReadTiming>,
+}
+
+/// `read_raw` on a large row's file, timed in the bench's process (the file in the page cache).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ReadTiming {
+    pub runs: usize,
+    pub median_ms: f64,
+    pub min_ms: f64,
+    /// The file's size over the median time.
+    pub mb_s: f64,
+    /// CPU time (user and system, every thread) of the median run, ms.
+    pub cpu_ms: f64,
 }
 
 /// The tessellation with about `millions` million triangles, the ring twice the tube's count.
@@ -161,8 +181,32 @@ fn reset_peak() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
 }
 
+/// CPU seconds (user and system) used so far by this process (`children: false`) or by its
+/// children waited for (`true`); NaN where unknown.
+pub(crate) fn cpu_seconds(children: bool) -> f64 {
+    #[cfg(unix)]
+    {
+        let who = if children { libc::RUSAGE_CHILDREN } else { libc::RUSAGE_SELF };
+        let mut u = std::mem::MaybeUninit::<libc::rusage>::zeroed();
+        // SAFETY: getrusage writes one rusage into the buffer it is given.
+        if unsafe { libc::getrusage(who, u.as_mut_ptr()) } == 0 {
+            // SAFETY: initialised by the successful call above.
+            let u = unsafe { u.assume_init() };
+            let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+            return s(u.ru_utime) + s(u.ru_stime);
+        }
+    }
+    let _ = children;
+    f64::NAN
+}
+
 /// Bakes the LOW at `low` from HIGH generated in this process, as `bake` does, and measures it.
-fn bake_in_memory(low: &Path, out: &Path, mesh: RawMesh, size: usize) -> Result<(crate::bake::BakeReport, f64, u64)> {
+fn bake_in_memory(
+    low: &Path,
+    out: &Path,
+    mesh: RawMesh,
+    size: usize,
+) -> Result<(crate::bake::BakeReport, f64, f64, u64)> {
     use crate::transfer::Settings;
     let given = std::sync::Arc::new(std::sync::Mutex::new(Some(mesh)));
     let job = crate::bake::BakeJob {
@@ -179,78 +223,131 @@ fn bake_in_memory(low: &Path, out: &Path, mesh: RawMesh, size: usize) -> Result<
     };
     // The generated mesh is HIGH as a reader would hand it over: it counts in the peak.
     reset_peak();
-    let t = std::time::Instant::now();
+    let (t, cpu) = (std::time::Instant::now(), cpu_seconds(false));
     let r = crate::bake::run(&job)?;
-    Ok((r, t.elapsed().as_secs_f64(), peak_bytes()))
+    Ok((r, t.elapsed().as_secs_f64(), cpu_seconds(false) - cpu, peak_bytes()))
 }
 
-/// One large row: HIGH of `n_th x n_ph` quads from `source`, LOW at `low`, a `size`² map.
+/// `read_raw` on `path`, `runs` times in this process: the reader alone.
+pub fn time_reader(path: &Path, runs: usize) -> Result<ReadTiming> {
+    let mut times = Vec::new();
+    let mut cpus = Vec::new();
+    for _ in 0..runs.max(1) {
+        let (t, cpu) = (std::time::Instant::now(), cpu_seconds(false));
+        let m = crate::format::raw::read_raw(path, &crate::scene::ReadOptions::default())?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        cpus.push((cpu_seconds(false) - cpu) * 1e3);
+        drop(m);
+    }
+    let mb = std::fs::metadata(path).map_or(0.0, |m| m.len() as f64 / 1e6);
+    let min_ms = times.iter().cloned().fold(f64::INFINITY, f64::min);
+    let median_ms = super::median(&mut times);
+    Ok(ReadTiming {
+        runs: times.len(),
+        median_ms,
+        min_ms,
+        mb_s: mb / median_ms * 1e3,
+        cpu_ms: super::median(&mut cpus),
+    })
+}
+
+/// One large row: HIGH of `n_th x n_ph` quads from `source`, LOW at `low`, as `plan` says.
 pub fn large_row(
     exe: &Path,
     dir: &Path,
     low: &Path,
     (n_th, n_ph): (usize, usize),
     source: Source,
-    size: usize,
+    plan: &Plan,
 ) -> Result<LargeRow> {
     let torus = Torus::default();
     let tris = 2 * n_th * n_ph;
-    let mesh = torus.high_raw(n_th, n_ph);
     let reach = 0.05 * 2.0 * (torus.major + torus.minor);
     let truth = |p: DVec3, d: DVec3| torus.truth(p, d, reach);
-    let row = |file_mb, wall_s, stages: [f64; 3], peak: u64, high_bytes: f64, error| LargeRow {
+    let mut row = LargeRow {
         high_triangles: tris,
         source,
-        size,
-        file_mb,
-        wall_s,
-        read_high_ms: stages[0],
-        bvh_ms: stages[1],
-        rays_ms: stages[2],
-        peak_mb: peak as f64 / 1e6,
-        bytes_per_triangle: peak as f64 / tris as f64,
-        high_bytes_per_triangle: high_bytes / tris as f64,
-        error,
+        size: plan.size,
+        file_mb: 0.0,
+        wall_s: f64::NAN,
+        cpu_s: f64::NAN,
+        read_high_ms: f64::NAN,
+        read_mb_s: 0.0,
+        bvh_ms: f64::NAN,
+        rays_ms: f64::NAN,
+        peak_mb: f64::NAN,
+        bytes_per_triangle: f64::NAN,
+        high_bytes_per_triangle: f64::NAN,
+        error: Evaluation::default(),
+        reader: None,
+    };
+    let set_peak = |row: &mut LargeRow, peak: f64, high_bytes: f64| {
+        row.peak_mb = peak / 1e6;
+        row.bytes_per_triangle = peak / tris as f64;
+        row.high_bytes_per_triangle = high_bytes / tris as f64;
     };
     if source == Source::Memory {
+        if !plan.bake {
+            return Ok(row);
+        }
         let out = dir.join(format!("out_mem_{tris}.glb"));
-        let (r, wall, peak) = bake_in_memory(low, &out, mesh, size)?;
+        let (r, wall, cpu, peak) = bake_in_memory(low, &out, torus.high_raw(n_th, n_ph), plan.size)?;
         let tr = r.transfer.ok_or_else(|| Error::usage("bench transfer: the bake made no transfer report"))?;
         let stage = |n: &str| tr.timings_ms.stages.iter().find(|s| s.0 == n).map_or(f64::NAN, |s| s.1);
-        let error = evaluate(&out, &truth, &|_| true)?;
+        row.error = evaluate(&out, &truth, &|_| true)?;
         let _ = std::fs::remove_file(&out);
-        let stages = [stage("read high"), stage("bvh"), stage("rays")];
-        return Ok(row(0.0, wall, stages, peak, tr.high_bytes as f64, error));
+        (row.wall_s, row.cpu_s) = (wall, cpu);
+        (row.read_high_ms, row.bvh_ms, row.rays_ms) = (stage("read high"), stage("bvh"), stage("rays"));
+        set_peak(&mut row, peak as f64, tr.high_bytes as f64);
+        return Ok(row);
     }
     let path = dir.join(format!("high_{tris}.{}", if source == Source::Obj { "obj" } else { "ply" }));
-    match source {
-        Source::Obj => write_obj(&mesh, &path)?,
-        _ => write_ply(&mesh, &path)?,
+    // A kept file is reused: the writer is deterministic, and a 50M-triangle OBJ takes a while.
+    if !(plan.keep && path.exists()) {
+        let mesh = torus.high_raw(n_th, n_ph);
+        match source {
+            Source::Obj => write_obj(&mesh, &path)?,
+            _ => write_ply(&mesh, &path)?,
+        }
     }
-    drop(mesh);
-    let file_mb = std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6);
-    let r = time_one(exe, dir, low, &path, tris, size, 1, 1, &torus);
-    let _ = std::fs::remove_file(&path);
-    let r = r?;
-    let stages = [r.read_high_ms, r.bvh_ms, r.rays_ms];
-    let high_bytes = r.high_bytes_per_triangle * tris as f64;
-    Ok(row(file_mb, r.median_s, stages, (r.peak_mb * 1e6) as u64, high_bytes, r.error))
+    row.file_mb = std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6);
+    let r = (|| {
+        if plan.read_runs > 0 {
+            row.reader = Some(time_reader(&path, plan.read_runs)?);
+        }
+        if plan.bake {
+            let cpu = cpu_seconds(true);
+            let r = time_one(exe, dir, low, &path, tris, plan.size, 1, 1, &torus)?;
+            row.cpu_s = cpu_seconds(true) - cpu;
+            (row.wall_s, row.error) = (r.median_s, r.error);
+            (row.read_high_ms, row.bvh_ms, row.rays_ms) = (r.read_high_ms, r.bvh_ms, r.rays_ms);
+            row.read_mb_s = row.file_mb / r.read_high_ms * 1e3;
+            set_peak(&mut row, r.peak_mb * 1e6, r.high_bytes_per_triangle * tris as f64);
+        }
+        Ok(())
+    })();
+    if !plan.keep {
+        let _ = std::fs::remove_file(&path);
+    }
+    r.map(|()| row)
 }
 
 /// The large rows as a text table.
 pub fn table(rows: &[LargeRow]) -> String {
     let mut s = String::from(
-        "HIGH tris  from     file MB  size  wall s  read ms  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°\n",
+        "HIGH tris  from     file MB  size  wall s  CPU s  read ms  read MB/s  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°\n",
     );
     for r in rows {
         s += &format!(
-            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>8.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}\n",
+            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>6.2} {:>8.0} {:>10.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}\n",
             r.high_triangles,
             format!("{:?}", r.source).to_lowercase(),
             r.file_mb,
             r.size,
             r.wall_s,
+            r.cpu_s,
             r.read_high_ms,
+            r.read_mb_s,
             r.bvh_ms,
             r.rays_ms,
             r.peak_mb,
@@ -259,6 +356,25 @@ pub fn table(rows: &[LargeRow]) -> String {
             r.error.synced.mean,
             r.error.synced.p99
         );
+    }
+    let timed: Vec<&LargeRow> = rows.iter().filter(|r| r.reader.is_some()).collect();
+    if !timed.is_empty() {
+        s += "\nThe reader alone (read_raw in the bench's process, median of runs):\n";
+        s += "HIGH tris  from     file MB  runs  median ms  min ms   MB/s  CPU ms\n";
+        for r in timed {
+            let t = r.reader.as_ref().expect("filtered");
+            s += &format!(
+                "{:>9}  {:<7} {:>8.0} {:>5} {:>10.0} {:>7.0} {:>6.0} {:>7.0}\n",
+                r.high_triangles,
+                format!("{:?}", r.source).to_lowercase(),
+                r.file_mb,
+                t.runs,
+                t.median_ms,
+                t.min_ms,
+                t.mb_s,
+                t.cpu_ms
+            );
+        }
     }
     s
 }
@@ -270,6 +386,12 @@ pub struct Plan {
     pub millions: Vec<f64>,
     pub sources: Vec<Source>,
     pub size: usize,
+    /// Runs of the reader alone on each file row (0: none).
+    pub read_runs: usize,
+    /// Whether to bake (false: only the reader is timed).
+    pub bake: bool,
+    /// Keep the HIGH files in the scratch folder, and reuse those found there.
+    pub keep: bool,
 }
 
 /// Every row of `plan`, with the bench's LOW written into `dir`.
@@ -283,7 +405,10 @@ pub fn run(exe: &Path, dir: &Path, plan: &Plan, mut progress: impl FnMut(&LargeR
     std::fs::write(&low, Torus::default().low(48, 24).glb()).map_err(|e| Error::output(&low, e))?;
     for &m in &plan.millions {
         for &source in &plan.sources {
-            let r = large_row(exe, dir, &low, tessellation(m), source, plan.size)?;
+            if source == Source::Memory && !plan.bake {
+                continue;
+            }
+            let r = large_row(exe, dir, &low, tessellation(m), source, plan)?;
             progress(&r);
             rows.push(r);
         }

@@ -11,6 +11,8 @@
 //! Values are kept as the file stores them (UV v up); the glue in `obj.rs` (a Scene) and
 //! `raw.rs` (a RawMesh) converts. Polygons are fanned from their first corner, as `tobj` did.
 
+use super::obj_fast::{fast_corners, fast_floats, parse_int};
+pub use super::obj_fast::{lead_f32, parse_f32};
 use crate::error::{Error, Result};
 use crate::progress::{Counting, Reporter};
 use memchr::memchr;
@@ -80,7 +82,12 @@ fn reported(
 }
 
 /// Parses from `r` with pieces of about `piece` bytes (small in tests, to cut lines everywhere).
-pub fn parse_reader(path: &Path, mut r: impl Read, piece: usize) -> Result<ObjData> {
+pub fn parse_reader(path: &Path, r: impl Read, piece: usize) -> Result<ObjData> {
+    parse_with::<true>(path, r, piece)
+}
+
+/// [`parse_reader`], with or without the common lines' own path (the tests compare the two).
+fn parse_with<const FAST: bool>(path: &Path, mut r: impl Read, piece: usize) -> Result<ObjData> {
     let piece = piece.max(1);
     let block = piece * PIECES_PER_BLOCK;
     let mut acc = Acc::default();
@@ -107,7 +114,7 @@ pub fn parse_reader(path: &Path, mut r: impl Read, piece: usize) -> Result<ObjDa
         let start = if first && buf.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
         first = false;
         let cut = if eof { buf.len() } else { buf.iter().rposition(|&c| c == b'\n').map_or(start, |i| i + 1) };
-        acc.block(path, &buf[start..cut], piece)?;
+        acc.block::<FAST>(path, &buf[start..cut], piece)?;
         buf.drain(..cut);
     }
     acc.finish(path)
@@ -138,7 +145,7 @@ struct Acc {
 }
 
 impl Acc {
-    fn block(&mut self, path: &Path, bytes: &[u8], piece: usize) -> Result<()> {
+    fn block<const FAST: bool>(&mut self, path: &Path, bytes: &[u8], piece: usize) -> Result<()> {
         let pieces = split(bytes, piece);
         let counts: Vec<Counts> = pieces.par_iter().map(|p| count(p)).collect();
         let mut bases = Vec::with_capacity(pieces.len());
@@ -156,7 +163,7 @@ impl Acc {
             return Err(Error::input(path, "more than 4 billion vertices: too large for 32-bit indices"));
         }
         let parsed: Vec<std::result::Result<Piece, (u64, String)>> =
-            pieces.par_iter().zip(&bases).map(|(p, base)| Piece::parse(p, *base)).collect();
+            pieces.par_iter().zip(&bases).map(|(p, base)| Piece::parse::<FAST>(p, *base)).collect();
         for p in parsed {
             let p = p.map_err(|(line, msg)| Error::input(path, format!("OBJ line {line}: {msg}")))?;
             self.append(p);
@@ -254,7 +261,7 @@ enum Kind {
     Other,
 }
 
-fn is_space(c: u8) -> bool {
+pub(super) fn is_space(c: u8) -> bool {
     matches!(c, b' ' | b'\t' | b'\r' | 0x0b | 0x0c)
 }
 
@@ -288,11 +295,14 @@ fn count(b: &[u8]) -> Counts {
     let mut c = Counts::default();
     let mut i = 0;
     while i < b.len() {
-        match keyword(b, i).0 {
-            Kind::V => c.v += 1,
-            Kind::Vt => c.t += 1,
-            Kind::Vn => c.n += 1,
-            _ => {}
+        // Only a line starting with `v` or with blanks can be a `v`/`vt`/`vn` line.
+        if b[i] == b'v' || is_space(b[i]) {
+            match keyword(b, i).0 {
+                Kind::V => c.v += 1,
+                Kind::Vt => c.t += 1,
+                Kind::Vn => c.n += 1,
+                _ => {}
+            }
         }
         i = line_end(b, i) + 1;
         c.lines += 1;
@@ -315,7 +325,7 @@ struct Piece {
     any_n: bool,
 }
 
-type Corner = [u32; 3];
+pub(super) type Corner = [u32; 3];
 
 /// A cursor over one line.
 struct Line<'a> {
@@ -351,7 +361,10 @@ impl<'a> Line<'a> {
 }
 
 impl Piece {
-    fn parse(b: &[u8], base: Counts) -> std::result::Result<Piece, (u64, String)> {
+    /// Parses one piece; with `FAST` (always, but in the tests that compare both), the common
+    /// lines (`v`/`vn`/`vt` with plain numbers, faces of positive indices already defined) take a
+    /// path of their own; anything else on such a line sends it down the general path.
+    fn parse<const FAST: bool>(b: &[u8], base: Counts) -> std::result::Result<Piece, (u64, String)> {
         let mut p = Piece::default();
         let mut i = 0;
         let mut line = base.lines;
@@ -359,6 +372,12 @@ impl Piece {
         let mut pending: Vec<Forward> = Vec::new();
         while i < b.len() {
             line += 1;
+            if FAST {
+                if let Some(next) = p.fast_line(b, i, base, &mut corners) {
+                    i = next;
+                    continue;
+                }
+            }
             let end = line_end(b, i);
             let (kind, after) = keyword(b, i);
             let mut l = Line { b: &b[..end], i: after };
@@ -403,10 +422,52 @@ impl Piece {
         Ok(p)
     }
 
+    /// The line at `i` if it is a common one, parsed; where the next line starts. `None` (nothing
+    /// kept) for any other line, which the general path then reads.
+    #[inline]
+    fn fast_line(&mut self, b: &[u8], i: usize, base: Counts, corners: &mut Vec<Corner>) -> Option<usize> {
+        let (c0, c1) = (b[i], *b.get(i + 1)?);
+        if c0 == b'v' {
+            if c1 == b' ' {
+                let (v, next) = fast_floats::<3>(b, i + 2)?;
+                self.pos.push(v);
+                return Some(next);
+            }
+            if *b.get(i + 2)? == b' ' {
+                if c1 == b'n' {
+                    let (v, next) = fast_floats::<3>(b, i + 3)?;
+                    self.nrm.push(v);
+                    return Some(next);
+                }
+                if c1 == b't' {
+                    let (v, next) = fast_floats::<2>(b, i + 3)?;
+                    self.uv.push(v);
+                    return Some(next);
+                }
+            }
+            return None;
+        }
+        if c0 != b'f' || c1 != b' ' {
+            return None;
+        }
+        let now = [base.v + self.pos.len() as u64, base.t + self.uv.len() as u64, base.n + self.nrm.len() as u64];
+        let next = fast_corners(b, i + 2, now, corners)?;
+        self.fan(corners);
+        Some(next)
+    }
+
     fn vertex(&mut self, l: &mut Line) -> std::result::Result<(), String> {
         let mut v = [l.float("v")?, l.float("v")?, l.float("v")?];
-        let extra: Vec<&[u8]> = std::iter::from_fn(|| l.token()).take(4).collect();
-        match extra.len() {
+        let mut extra: [&[u8]; 4] = [&[]; 4];
+        let mut n = 0;
+        while n < 4 {
+            match l.token() {
+                Some(t) => extra[n] = t,
+                None => break,
+            }
+            n += 1;
+        }
+        match n {
             0 | 3 => {} // x y z, or x y z r g b (colours are not kept)
             1 => {
                 let w = parse_f32(extra[0]).ok_or("v: its w is not a number")?;
@@ -415,7 +476,7 @@ impl Piece {
                 }
                 v = v.map(|x| x / w);
             }
-            n => return Err(format!("v has {} numbers (expected 3, 4 with w, or 6 with a colour)", n + 3)),
+            _ => return Err(format!("v has {} numbers (expected 3, 4 with w, or 6 with a colour)", n + 3)),
         }
         self.pos.push(v);
         Ok(())
@@ -472,6 +533,13 @@ impl Piece {
             return Ok(()); // points and lines carry no surface
         }
         self.forward.append(pending);
+        self.fan(corners);
+        Ok(())
+    }
+
+    /// A polygon's triangles, fanned from its first corner (at least three corners).
+    #[inline]
+    fn fan(&mut self, corners: &[Corner]) {
         let has_t = corners.iter().any(|c| c[1] != MISSING);
         let has_n = corners.iter().any(|c| c[2] != MISSING);
         if has_t && !self.any_t {
@@ -493,111 +561,7 @@ impl Piece {
                 self.tn.push([a[2], b[2], c[2]]);
             }
         }
-        Ok(())
     }
-}
-
-fn parse_int(t: &[u8]) -> Option<i64> {
-    let (neg, d) = match t.first()? {
-        b'-' => (true, &t[1..]),
-        b'+' => (false, &t[1..]),
-        _ => (false, t),
-    };
-    if d.is_empty() || d.len() > 18 {
-        return None;
-    }
-    let mut x: i64 = 0;
-    for &c in d {
-        if !c.is_ascii_digit() {
-            return None;
-        }
-        x = x * 10 + (c - b'0') as i64;
-    }
-    Some(if neg { -x } else { x })
-}
-
-const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
-    1e21, 1e22,
-];
-
-/// A decimal as the nearest f32, exactly as `str::parse::<f32>` gives it.
-///
-/// Fast path: a mantissa of at most 2^53 and a power of ten of at most 22 are both exact in f64,
-/// so one multiplication or division gives the correctly rounded f64. Rounding that to f32 is
-/// correct unless the f64 landed exactly on the midpoint between two f32s (rounding is monotonic
-/// and every f32 midpoint is an f64, so x and its f64 fall between the same two midpoints
-/// otherwise); that case, and everything else, goes to the standard library.
-pub fn parse_f32(t: &[u8]) -> Option<f32> {
-    let slow = || std::str::from_utf8(t).ok()?.parse::<f32>().ok();
-    let (neg, mut p) = match t.first() {
-        Some(b'-') => (true, 1),
-        Some(b'+') => (false, 1),
-        _ => (false, 0),
-    };
-    let (mut w, mut e, mut digits) = (0u64, 0i32, 0);
-    while p < t.len() && t[p].is_ascii_digit() {
-        if w >= 100_000_000_000_000_000 {
-            return slow();
-        }
-        w = w * 10 + (t[p] - b'0') as u64;
-        digits += 1;
-        p += 1;
-    }
-    if p < t.len() && t[p] == b'.' {
-        p += 1;
-        while p < t.len() && t[p].is_ascii_digit() {
-            if w >= 100_000_000_000_000_000 {
-                return slow();
-            }
-            w = w * 10 + (t[p] - b'0') as u64;
-            e -= 1;
-            digits += 1;
-            p += 1;
-        }
-    }
-    if digits == 0 {
-        return slow();
-    }
-    if p < t.len() && (t[p] | 0x20) == b'e' {
-        p += 1;
-        let eneg = match t.get(p) {
-            Some(b'-') => {
-                p += 1;
-                true
-            }
-            Some(b'+') => {
-                p += 1;
-                false
-            }
-            _ => false,
-        };
-        let (mut x, s) = (0i32, p);
-        while p < t.len() && t[p].is_ascii_digit() && p - s < 6 {
-            x = x * 10 + (t[p] - b'0') as i32;
-            p += 1;
-        }
-        if p == s {
-            return slow();
-        }
-        e += if eneg { -x } else { x };
-    }
-    if p != t.len() {
-        return slow();
-    }
-    let v = if w == 0 {
-        0.0
-    } else {
-        if w > 1 << 53 || !(-22..=22).contains(&e) {
-            return slow();
-        }
-        let r = if e >= 0 { w as f64 * POW10[e as usize] } else { w as f64 / POW10[(-e) as usize] };
-        if r.to_bits() & ((1 << 29) - 1) == 1 << 28 {
-            return slow();
-        }
-        r as f32
-    };
-    Some(if neg { -v } else { v })
 }
 
 #[cfg(test)]

@@ -172,3 +172,71 @@ fn any_piece_size_gives_the_same_result() {
         assert!(e.contains(&format!("line {lines}:")), "{e}");
     }
 }
+
+struct Rng(u64);
+
+impl Rng {
+    fn below(&mut self, n: usize) -> usize {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 % n as u64) as usize
+    }
+    fn pick<'a>(&mut self, from: &[&'a str]) -> &'a str {
+        from[self.below(from.len())]
+    }
+}
+
+/// The common lines' own path reads every line as the general path does: random files mixing
+/// plain lines with everything that must leave it (tabs, comments, w, colours, signs, exponents,
+/// odd corners, negative and forward indices, junk), read both ways, give the same data or the
+/// same error.
+#[test]
+fn fast_path_reads_as_the_general_path() {
+    let mut r = Rng(0x2545_F491_4F6C_DD1D);
+    let nums = ["1", "-0", "0.5", ".25", "1e-3", "-2.5E+1", "3.", "7", "inf", "1x", "1-2", "0.1000000015", "+4"];
+    let sep = [" ", " ", " ", "  ", "\t", " \x0b"];
+    let ends = ["\n", "\n", "\n", "\r\n", " \n", " # c\n", "\t\n", " x\n", "\r \n"];
+    // Mostly small positive indices, which the fast path takes.
+    let idx = ["1", "2", "3", "1", "2", "3", "1", "2", "-1", "-2", "9", "0", "12345678901", "+1", "1a", ""];
+    let numbers =
+        |r: &mut Rng, k: usize| (0..k).map(|_| format!("{}{}", r.pick(&sep), r.pick(&nums))).collect::<String>();
+    for file in 0..300 {
+        let mut s = String::new();
+        for _ in 0..40 {
+            let e = r.pick(&ends);
+            match r.below(8) {
+                0 | 1 => {
+                    let k = [3, 3, 3, 3, 4, 6, 5][r.below(7)];
+                    s += &format!("v{}{e}", numbers(&mut r, k));
+                }
+                2 | 3 => {
+                    let k = r.below(8) / 7;
+                    let (kw, k) = if r.below(2) == 0 { ("vn", 3 + k) } else { ("vt", 2 + k) };
+                    s += &format!("{kw}{}{e}", numbers(&mut r, k));
+                }
+                4 | 5 => {
+                    let shape = r.below(4);
+                    let mut f = String::from("f");
+                    for _ in 0..2 + r.below(4) {
+                        f += r.pick(&sep);
+                        f += &match shape {
+                            0 => r.pick(&idx).to_string(),
+                            1 => format!("{}/{}", r.pick(&idx), r.pick(&idx)),
+                            2 => format!("{}//{}", r.pick(&idx), r.pick(&idx)),
+                            _ => format!("{}/{}/{}", r.pick(&idx), r.pick(&idx), r.pick(&idx)),
+                        };
+                    }
+                    s += &format!("{f}{e}");
+                }
+                6 => s += r.pick(&["g part\n", "usemtl m\n", "# note\n", "\n", "s 1\n", "o\n"]),
+                _ => s += "v 0 0 0\nvt 0 0\nvn 0 0 1\n",
+            }
+        }
+        for piece in [7, 1 << 20] {
+            let fast = parse_with::<true>(Path::new("t.obj"), s.as_bytes(), piece).map_err(|e| e.to_string());
+            let slow = parse_with::<false>(Path::new("t.obj"), s.as_bytes(), piece).map_err(|e| e.to_string());
+            assert_eq!(fast, slow, "file {file}, piece {piece}:\n{s}");
+        }
+    }
+}

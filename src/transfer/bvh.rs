@@ -92,7 +92,8 @@ impl Bvh {
         let nodes = if items.is_empty() {
             vec![Node { min: [0.0; 3], a: 0, max: [0.0; 3], n: 0 }]
         } else {
-            build_par(&mut items, 0)
+            let bc = bounds_of(&items);
+            build_par(&mut items, 0, bc)
         };
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         drop(items);
@@ -117,22 +118,91 @@ impl Bvh {
     }
 }
 
+/// The items' bounds and their centres' bounds (on every core for a large range: min and max
+/// give the same boxes in any grouping).
 fn bounds_of(items: &[Item]) -> (Aabb, Aabb) {
+    use rayon::prelude::*;
+    let one = |items: &[Item]| {
+        let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
+        for it in items {
+            b.join(&it.bounds());
+            c.grow(it.centre());
+        }
+        (b, c)
+    };
+    if items.len() < PARALLEL_MIN * 4 {
+        return one(items);
+    }
+    items.par_chunks(PARALLEL_MIN).map(one).reduce(
+        || (Aabb::EMPTY, Aabb::EMPTY),
+        |(mut b, mut c), (b2, c2)| {
+            b.join(&b2);
+            c.join(&c2);
+            (b, c)
+        },
+    )
+}
+
+/// Per bin: the items' bounds, their centres' bounds and their count.
+type Bins = [(Aabb, Aabb, usize); BINS];
+
+/// The items binned by centre along `axis` (in parallel for a large range; the same bins in any
+/// grouping).
+fn bin(items: &[Item], c: &Aabb, axis: usize) -> Bins {
+    use rayon::prelude::*;
+    let scale = BINS as f32 / (c.max[axis] - c.min[axis]);
+    let one = |items: &[Item]| {
+        let mut bins = [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS];
+        for it in items {
+            let m = it.centre();
+            let k = (((m[axis] - c.min[axis]) * scale) as usize).min(BINS - 1);
+            bins[k].0.join(&it.bounds());
+            bins[k].1.grow(m);
+            bins[k].2 += 1;
+        }
+        bins
+    };
+    if items.len() < PARALLEL_MIN * 4 {
+        return one(items);
+    }
+    items.par_chunks(PARALLEL_MIN).map(one).reduce(
+        || [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS],
+        |mut a, b| {
+            for (x, y) in a.iter_mut().zip(&b) {
+                x.0.join(&y.0);
+                x.1.join(&y.1);
+                x.2 += y.2;
+            }
+            a
+        },
+    )
+}
+
+/// The bounds and centre bounds of bins `r`: a child's, with no pass over its items.
+fn bins_bounds(bins: &Bins, r: std::ops::Range<usize>) -> (Aabb, Aabb) {
     let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
-    for it in items {
-        b.join(&it.bounds());
-        c.grow(it.centre());
+    for x in &bins[r] {
+        b.join(&x.0);
+        c.join(&x.1);
     }
     (b, c)
+}
+
+/// A split: the axis, the bin boundary, and each side's bounds and centre bounds.
+struct Split {
+    axis: usize,
+    k: usize,
+    left: (Aabb, Aabb),
+    right: (Aabb, Aabb),
 }
 
 fn leaf(b: &Aabb, first: usize, n: usize) -> Node {
     Node { min: b.min.to_array(), a: first as u32, max: b.max.to_array(), n: n as u32 }
 }
 
-/// The best binned-SAH split of `items` along the centres' longest axis: `(axis, bin boundary)`,
-/// or `None` when a leaf is cheaper or the centres cannot be told apart.
-fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<(usize, usize)> {
+/// The best binned-SAH split of `items` along the centres' longest axis, or `None` when a leaf
+/// is cheaper or the centres cannot be told apart.
+fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
     let extent = c.max - c.min;
     // One axis only: a third of the binning work of trying all three; on the benchmark's HIGH
     // the whole bake took less CPU time this way (build cheaper, tracing no slower).
@@ -147,26 +217,20 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<(usize, usize)> {
     if e.is_nan() || e <= 0.0 {
         return None;
     }
-    let scale = BINS as f32 / e;
-    let mut bins = [(Aabb::EMPTY, 0usize); BINS];
-    for it in items {
-        let k = (((it.centre()[axis] - c.min[axis]) * scale) as usize).min(BINS - 1);
-        bins[k].0.join(&it.bounds());
-        bins[k].1 += 1;
-    }
+    let bins = bin(items, c, axis);
     // Sweep from the right, then from the left: the cost of each boundary.
     let mut right_cost = [0.0f32; BINS];
     let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
     for k in (1..BINS).rev() {
         acc.join(&bins[k].0);
-        cnt += bins[k].1;
+        cnt += bins[k].2;
         right_cost[k] = acc.area() * cnt as f32;
     }
     let mut best: Option<(f32, usize)> = None;
     let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
     for k in 1..BINS {
         acc.join(&bins[k - 1].0);
-        cnt += bins[k - 1].1;
+        cnt += bins[k - 1].2;
         if cnt == 0 || cnt == items.len() {
             continue;
         }
@@ -182,7 +246,7 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<(usize, usize)> {
     if items.len() <= MAX_LEAF && cost + 2.0 * b.area() >= leaf_cost {
         return None;
     }
-    Some((axis, k))
+    Some(Split { axis, k, left: bins_bounds(&bins, 0..k), right: bins_bounds(&bins, k..BINS) })
 }
 
 /// Moves the items left of bin boundary `k` on `axis` to the front; returns how many there are.
@@ -199,25 +263,32 @@ fn partition(items: &mut [Item], c: &Aabb, axis: usize, k: usize) -> usize {
     i
 }
 
-/// Splits `items` in two halves of equal count when the bins cannot (identical centres).
-fn median_split(items: &mut [Item]) -> usize {
-    items.len() / 2
+/// Where `items` split and each side's bounds: by the best binned split, else in two halves of
+/// equal count (identical centres).
+fn divide(items: &mut [Item], b: &Aabb, c: &Aabb) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
+    match split(items, b, c) {
+        Some(sp) => (partition(items, c, sp.axis, sp.k), sp.left, sp.right),
+        None => halves(items),
+    }
 }
 
-/// Builds the subtree over `items` (which start at `offset` in leaf order); its root is node 0.
-fn build_par(items: &mut [Item], offset: usize) -> Vec<Node> {
+fn halves(items: &[Item]) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
+    let mid = items.len() / 2;
+    (mid, bounds_of(&items[..mid]), bounds_of(&items[mid..]))
+}
+
+/// Builds the subtree over `items` (which start at `offset` in leaf order, with bounds and
+/// centre bounds `bc`); its root is node 0.
+fn build_par(items: &mut [Item], offset: usize, bc: (Aabb, Aabb)) -> Vec<Node> {
     if items.len() < PARALLEL_MIN {
         let mut nodes = Vec::with_capacity(items.len() / 2 + 1);
-        build_serial(items, offset, &mut nodes);
+        build_serial(items, offset, &mut nodes, bc);
         return nodes;
     }
-    let (b, c) = bounds_of(items);
-    let mid = match split(items, &b, &c) {
-        Some((axis, k)) => partition(items, &c, axis, k),
-        None => median_split(items),
-    };
+    let (b, c) = bc;
+    let (mid, lb, rb) = divide(items, &b, &c);
     let (l, r) = items.split_at_mut(mid);
-    let (mut left, mut right) = rayon::join(|| build_par(l, offset), || build_par(r, offset + mid));
+    let (mut left, mut right) = rayon::join(|| build_par(l, offset, lb), || build_par(r, offset + mid, rb));
     let shift = |nodes: &mut [Node], by: u32| {
         for n in nodes.iter_mut().filter(|n| n.n == 0) {
             n.a += by;
@@ -232,22 +303,21 @@ fn build_par(items: &mut [Item], offset: usize) -> Vec<Node> {
     nodes
 }
 
-fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>) {
-    let (b, c) = bounds_of(items);
+fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, (b, c): (Aabb, Aabb)) {
     let me = nodes.len();
-    let mid = match split(items, &b, &c) {
-        Some((axis, k)) => partition(items, &c, axis, k),
+    let (mid, lb, rb) = match split(items, &b, &c) {
+        Some(sp) => (partition(items, &c, sp.axis, sp.k), sp.left, sp.right),
         None if items.len() <= MAX_LEAF * 2 => {
             nodes.push(leaf(&b, offset, items.len()));
             return;
         }
-        None => median_split(items),
+        None => halves(items),
     };
     nodes.push(Node { min: b.min.to_array(), a: 0, max: b.max.to_array(), n: 0 });
     let (l, r) = items.split_at_mut(mid);
-    build_serial(l, offset, nodes);
+    build_serial(l, offset, nodes, lb);
     nodes[me].a = nodes.len() as u32;
-    build_serial(r, offset + mid, nodes);
+    build_serial(r, offset + mid, nodes, rb);
 }
 
 #[cfg(test)]
@@ -299,6 +369,24 @@ pub(crate) mod tests {
         }
         walk(&bvh, &pos, 0, &mut seen);
         assert!(seen.iter().all(|&s| s == 1));
+    }
+
+    /// The same tree, node for node, whatever the thread count (large enough for the parallel
+    /// binning and the parallel subtrees).
+    #[test]
+    fn same_tree_on_any_thread_count() {
+        let tris = grid_tris(260);
+        let build = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+            let (b, _) = pool.install(|| soup(&tris));
+            let nodes: Vec<_> =
+                b.nodes.iter().map(|n| (n.min.map(f32::to_bits), n.a, n.max.map(f32::to_bits), n.n)).collect();
+            (nodes, b.tris, b.ids)
+        };
+        assert!(tris.len() > PARALLEL_MIN * 8);
+        let one = build(1);
+        assert_eq!(one, build(2));
+        assert_eq!(one, build(3));
     }
 
     /// Identical triangles (no centre spread) still end in small leaves.

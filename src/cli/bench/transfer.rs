@@ -7,7 +7,9 @@ use bumpbake::{Error, Result};
 #[command(after_help = "Examples:
   bumpbake bench transfer
   bumpbake bench transfer --runs 7 --json > transfer-bench.json
-  bumpbake bench transfer --runs 0 --large 10 --large-from memory,obj")]
+  bumpbake bench transfer --runs 0 --large 10 --large-from memory,obj
+  bumpbake bench transfer --runs 0 --large 2 --large-from obj,ply --large-size 256
+  bumpbake bench transfer --runs 0 --large 2 --large-from obj,ply --read-only --keep /tmp/high")]
 pub struct BenchTransferArgs {
     /// Timed runs of each configuration (each a new process); medians are reported. 0 skips the
     /// 600k-and-below rows.
@@ -27,6 +29,17 @@ pub struct BenchTransferArgs {
     /// Map size of the large rows.
     #[arg(long, default_value_t = 2048)]
     pub large_size: usize,
+    /// Also time the reader alone (`read_raw`, in this process) this many times on each large
+    /// row's OBJ or PLY file, for its MB/s.
+    #[arg(long, default_value_t = 3)]
+    pub large_read: usize,
+    /// Time only the reader on the large rows' files: no bake (memory rows are skipped).
+    #[arg(long)]
+    pub read_only: bool,
+    /// Use DIR as the scratch folder and keep what is written there; large HIGH files found
+    /// there are reused (for profiling the reader or a bake on them).
+    #[arg(long, value_name = "DIR")]
+    pub keep: Option<std::path::PathBuf>,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -63,13 +76,20 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
     if !(1..=8192).contains(&a.large_size) {
         return Err(Error::usage("--large-size: 1 to 8192 texels"));
     }
-    let plan = Plan { millions, sources, size: a.large_size };
+    let plan = Plan {
+        millions,
+        sources,
+        size: a.large_size,
+        read_runs: a.large_read,
+        bake: !a.read_only,
+        keep: a.keep.is_some(),
+    };
     let quiet = a.json;
-    let r = super::shared::with_scratch("transfer", |exe, dir| {
-        let mut r = if a.runs == 0 {
+    let body = |exe: &std::path::Path, dir: &std::path::Path| {
+        let mut r = if a.runs == 0 || a.read_only {
             bumpbake::bench::transfer::Report::empty()
         } else {
-            bumpbake::bench::transfer::run(exe, dir, &quality, a.runs, |row| {
+            bumpbake::bench::transfer::run(exe, dir, &quality, a.runs, a.keep.is_some(), |row| {
                 if !quiet {
                     eprintln!(
                         "  {} triangles, {}², {} sample(s): {:.3} s, {:.3}° mean",
@@ -97,7 +117,15 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
             }
         })?;
         Ok(r)
-    })?;
+    };
+    let r = match &a.keep {
+        Some(dir) => {
+            let exe = std::env::current_exe()
+                .map_err(|e| Error::usage(format!("bench transfer: cannot find bumpbake itself: {e}")))?;
+            body(&exe, dir)?
+        }
+        None => super::shared::with_scratch("transfer", body)?,
+    };
     super::shared::print(&r, a.json, bumpbake::bench::transfer::table)?;
     Ok(0)
 }

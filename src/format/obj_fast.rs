@@ -1,0 +1,202 @@
+//! The numbers of an OBJ file and the path of its common lines: `v`/`vn`/`vt` with plain
+//! numbers and faces of positive indices, read straight from the bytes with no token scanned
+//! twice. Whatever else such a line holds sends it back to the general path in `obj_parse`.
+
+use super::obj_parse::{is_space, Corner, MISSING};
+
+/// `N` numbers from `i` on, each after one or more blanks, then the line's end (blanks and a
+/// `\r` allowed before it); the numbers and where the next line starts. `None` for anything else
+/// (a comment, a fourth number, text), which the general path reads.
+#[inline]
+pub(super) fn fast_floats<const N: usize>(b: &[u8], mut i: usize) -> Option<([f32; N], usize)> {
+    let mut v = [0f32; N];
+    for x in v.iter_mut() {
+        while *b.get(i)? == b' ' {
+            i += 1;
+        }
+        let (f, used) = lead_f32(&b[i..])?;
+        *x = f;
+        i += used;
+    }
+    Some((v, end_of_line(b, i)?))
+}
+
+/// Where the next line starts if only blanks (and a `\r`) are left on this one.
+#[inline]
+fn end_of_line(b: &[u8], mut i: usize) -> Option<usize> {
+    while i < b.len() && matches!(b[i], b' ' | b'\r') {
+        i += 1;
+    }
+    match b.get(i) {
+        None => Some(i),
+        Some(b'\n') => Some(i + 1),
+        _ => None,
+    }
+}
+
+/// A positive decimal index at `i` (no sign), as 0-based, if below `limit` (already defined);
+/// and where it ends.
+#[inline]
+fn fast_index(b: &[u8], mut i: usize, limit: u64) -> Option<(u32, usize)> {
+    let s = i;
+    let mut x: u64 = 0;
+    while i < b.len() && b[i].is_ascii_digit() && i - s < 10 {
+        x = x * 10 + (b[i] - b'0') as u64;
+        i += 1;
+    }
+    (x >= 1 && x <= limit && i > s).then(|| ((x - 1) as u32, i))
+}
+
+/// A face's corners from `i` on when every one is `v`, `v/vt`, `v//vn` or `v/vt/vn` with positive
+/// indices to what is already defined, followed by the line's end; where the next line starts.
+#[inline]
+pub(super) fn fast_corners(b: &[u8], mut i: usize, now: [u64; 3], corners: &mut Vec<Corner>) -> Option<usize> {
+    corners.clear();
+    loop {
+        while *b.get(i)? == b' ' {
+            i += 1;
+        }
+        if matches!(b[i], b'\r' | b'\n') {
+            break;
+        }
+        let mut c = [MISSING; 3];
+        (c[0], i) = fast_index(b, i, now[0])?;
+        if b.get(i) == Some(&b'/') {
+            i += 1;
+            if b.get(i) != Some(&b'/') {
+                (c[1], i) = fast_index(b, i, now[1])?;
+            }
+            if b.get(i) == Some(&b'/') {
+                (c[2], i) = fast_index(b, i + 1, now[2])?;
+            }
+        }
+        if !matches!(b.get(i), Some(b' ' | b'\r' | b'\n') | None) {
+            return None;
+        }
+        corners.push(c);
+        if i >= b.len() {
+            break;
+        }
+    }
+    if corners.len() < 3 {
+        return None;
+    }
+    end_of_line(b, i)
+}
+
+pub(super) fn parse_int(t: &[u8]) -> Option<i64> {
+    let (neg, d) = match t.first()? {
+        b'-' => (true, &t[1..]),
+        b'+' => (false, &t[1..]),
+        _ => (false, t),
+    };
+    if d.is_empty() || d.len() > 18 {
+        return None;
+    }
+    let mut x: i64 = 0;
+    for &c in d {
+        if !c.is_ascii_digit() {
+            return None;
+        }
+        x = x * 10 + (c - b'0') as i64;
+    }
+    Some(if neg { -x } else { x })
+}
+
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
+    1e21, 1e22,
+];
+
+/// A decimal as the nearest f32, exactly as `str::parse::<f32>` gives it.
+///
+/// Fast path: a mantissa of at most 2^53 and a power of ten of at most 22 are both exact in f64,
+/// so one multiplication or division gives the correctly rounded f64. Rounding that to f32 is
+/// correct unless the f64 landed exactly on the midpoint between two f32s (rounding is monotonic
+/// and every f32 midpoint is an f64, so x and its f64 fall between the same two midpoints
+/// otherwise); that case, and everything else, goes to the standard library.
+pub fn parse_f32(t: &[u8]) -> Option<f32> {
+    match lead_f32(t)? {
+        (v, n) if n == t.len() => Some(v),
+        _ => None,
+    }
+}
+
+/// The number that `t` starts with, as [`parse_f32`] reads it, and its length: the token runs to
+/// the first blank or newline (`None` when that token is not a number).
+#[inline]
+pub fn lead_f32(t: &[u8]) -> Option<(f32, usize)> {
+    let ends = |c: u8| is_space(c) || c == b'\n';
+    let slow = || {
+        let e = t.iter().position(|&c| ends(c)).unwrap_or(t.len());
+        Some((std::str::from_utf8(&t[..e]).ok()?.parse::<f32>().ok()?, e))
+    };
+    let (neg, mut p) = match t.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let (mut w, mut e, mut digits) = (0u64, 0i32, 0);
+    while p < t.len() && t[p].is_ascii_digit() {
+        if w >= 100_000_000_000_000_000 {
+            return slow();
+        }
+        w = w * 10 + (t[p] - b'0') as u64;
+        digits += 1;
+        p += 1;
+    }
+    if p < t.len() && t[p] == b'.' {
+        p += 1;
+        while p < t.len() && t[p].is_ascii_digit() {
+            if w >= 100_000_000_000_000_000 {
+                return slow();
+            }
+            w = w * 10 + (t[p] - b'0') as u64;
+            e -= 1;
+            digits += 1;
+            p += 1;
+        }
+    }
+    if digits == 0 {
+        return slow();
+    }
+    if p < t.len() && (t[p] | 0x20) == b'e' {
+        p += 1;
+        let eneg = match t.get(p) {
+            Some(b'-') => {
+                p += 1;
+                true
+            }
+            Some(b'+') => {
+                p += 1;
+                false
+            }
+            _ => false,
+        };
+        let (mut x, s) = (0i32, p);
+        while p < t.len() && t[p].is_ascii_digit() && p - s < 6 {
+            x = x * 10 + (t[p] - b'0') as i32;
+            p += 1;
+        }
+        if p == s {
+            return slow();
+        }
+        e += if eneg { -x } else { x };
+    }
+    if p < t.len() && !ends(t[p]) {
+        return slow();
+    }
+    let v = if w == 0 {
+        0.0
+    } else {
+        if w > 1 << 53 || !(-22..=22).contains(&e) {
+            return slow();
+        }
+        let r = if e >= 0 { w as f64 * POW10[e as usize] } else { w as f64 / POW10[(-e) as usize] };
+        if r.to_bits() & ((1 << 29) - 1) == 1 << 28 {
+            return slow();
+        }
+        r as f32
+    };
+    Some((if neg { -v } else { v }, p))
+}
