@@ -2,6 +2,7 @@
 //! tests and the binary share it.
 
 pub mod batch;
+pub mod blender;
 pub mod command;
 pub mod normalmap;
 pub mod plot;
