@@ -384,6 +384,8 @@ pub struct Row {
     /// What the baker's HIGH (tree, positions, triangles, normals) takes, per triangle.
     pub high_bytes_per_triangle: f64,
     pub error: Evaluation,
+    /// FNV-1a 64 of the last run's OUT: equal for equal maps (OUT names no input file).
+    pub out_fingerprint: String,
     /// Blender's bake of the same files, interleaved (`--blender`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blender: Option<super::blender::BlenderRow>,
@@ -453,6 +455,7 @@ pub(crate) fn time_one(
         }
     }
     let error = evaluate(&out, &|p, d| torus.truth(p, d, reach), &|_| true)?;
+    let out_fingerprint = std::fs::read(&out).map(|b| super::fingerprint(&b)).unwrap_or_default();
     let _ = std::fs::remove_file(&out);
     let (min_s, max_s) =
         (times.iter().cloned().fold(f64::INFINITY, f64::min), times.iter().cloned().fold(0.0, f64::max));
@@ -472,6 +475,7 @@ pub(crate) fn time_one(
         peak_mb: peak as f64 * 1024.0 / 1e6,
         high_bytes_per_triangle: high_bytes / tris as f64,
         error,
+        out_fingerprint,
         blender: blender.map(|_| theirs.row(median_s)),
     })
 }

@@ -51,6 +51,8 @@ pub struct LargeRow {
     /// What the baker's HIGH (tree, positions, triangles, normals) takes alone, per triangle.
     pub high_bytes_per_triangle: f64,
     pub error: Evaluation,
+    /// FNV-1a 64 of OUT: the same HIGH from memory, OBJ and PLY bakes the same bytes.
+    pub out_fingerprint: String,
     /// Runs of a file row (a memory row runs once); `wall_s` and the stages are medians.
     pub runs: usize,
     /// Blender's bake of the same files, interleaved (`--blender`, file rows only).
@@ -217,6 +219,7 @@ pub fn large_row(
         bytes_per_triangle: peak as f64 / tris as f64,
         high_bytes_per_triangle: high_bytes / tris as f64,
         error,
+        out_fingerprint: String::new(),
         runs: 1,
         blender: None,
     };
@@ -226,9 +229,11 @@ pub fn large_row(
         let tr = r.transfer.ok_or_else(|| Error::usage("bench transfer: the bake made no transfer report"))?;
         let stage = |n: &str| tr.timings_ms.stages.iter().find(|s| s.0 == n).map_or(f64::NAN, |s| s.1);
         let error = evaluate(&out, &truth, &|_| true)?;
+        let fingerprint = std::fs::read(&out).map(|b| super::fingerprint(&b)).unwrap_or_default();
         let _ = std::fs::remove_file(&out);
         let stages = [stage("read high"), stage("bvh"), stage("rays")];
-        return Ok(row(0.0, wall, stages, peak, tr.high_bytes as f64, error));
+        let row = row(0.0, wall, stages, peak, tr.high_bytes as f64, error);
+        return Ok(LargeRow { out_fingerprint: fingerprint, ..row });
     }
     let path = dir.join(format!("high_{tris}.{}", if source == Source::Obj { "obj" } else { "ply" }));
     match source {
@@ -243,17 +248,17 @@ pub fn large_row(
     let stages = [r.read_high_ms, r.bvh_ms, r.rays_ms];
     let high_bytes = r.high_bytes_per_triangle * tris as f64;
     let row = row(file_mb, r.median_s, stages, (r.peak_mb * 1e6) as u64, high_bytes, r.error);
-    Ok(LargeRow { runs: r.runs, blender: r.blender, ..row })
+    Ok(LargeRow { runs: r.runs, blender: r.blender, out_fingerprint: r.out_fingerprint, ..row })
 }
 
 /// The large rows as a text table.
 pub fn table(rows: &[LargeRow]) -> String {
     let mut s = String::from(
-        "HIGH tris  from     file MB  size  wall s  read ms  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°\n",
+        "HIGH tris  from     file MB  size  wall s  read ms  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°  OUT\n",
     );
     for r in rows {
         s += &format!(
-            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>8.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}\n",
+            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>8.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}  {}\n",
             r.high_triangles,
             format!("{:?}", r.source).to_lowercase(),
             r.file_mb,
@@ -266,7 +271,8 @@ pub fn table(rows: &[LargeRow]) -> String {
             r.bytes_per_triangle,
             r.high_bytes_per_triangle,
             r.error.synced.mean,
-            r.error.synced.p99
+            r.error.synced.p99,
+            &r.out_fingerprint[..r.out_fingerprint.len().min(8)]
         );
     }
     for r in rows {
