@@ -21,7 +21,7 @@
 
 use super::material::{Materials, PrimNeed, TextureUse, UvTransform};
 use super::nodes::Instance;
-use super::{to_triangle_list, PrimRef, Primitive, Scene};
+use super::{to_triangle_list, PrimRef, Primitive, Scene, Stream};
 use crate::error::Result;
 use crate::format::dequant;
 use serde_json::Value;
@@ -195,6 +195,19 @@ impl Geometry {
         self.uvs(self.tangent_uvs)
     }
 
+    /// The UVs the tangents follow on a morph target's mesh at weight 1: the stored set plus the
+    /// target's `delta` of it (none: the stored set), through the transform, as a renderer
+    /// morphs and then samples them. Zeros without the set.
+    pub fn morphed_tangent_uvs(&self, delta: Option<&Stream>) -> Vec<[f32; 2]> {
+        let n = self.primitive.vertex_count();
+        let mut uv: Vec<[f32; 2]> =
+            self.primitive.attr(&self.tangent_uvs.attribute()).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; n]);
+        if let Some(d) = delta {
+            uv.iter_mut().zip(d.to_f32::<2>()).for_each(|(a, b)| *a = [a[0] + b[0], a[1] + b[1]]);
+        }
+        dequant::transformed_uvs(uv.into(), self.tangent_uvs.transform.as_ref()).into_owned()
+    }
+
     /// TANGENT as floats, as stored (quantized ones decoded, not made unit: whether they are unit
     /// is for `validate` to judge), `w` included.
     pub fn tangents(&self) -> Option<Vec<[f32; 4]>> {
@@ -205,7 +218,7 @@ impl Geometry {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::accessor::{Format, Stream, BYTE, UNSIGNED_SHORT};
+    use crate::scene::accessor::{Format, BYTE, UNSIGNED_SHORT};
     use crate::scene::ReadOptions;
     use serde_json::json;
     use std::path::Path;

@@ -156,7 +156,7 @@ fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
     }
     let morph = if morph::needed(p, &uv_name) {
         let base = morph::Base { tangent: &tangent, normals: &normals, generated_normals };
-        morph::deltas(p, &uv_name, &base, opts.engine)
+        morph::deltas(g, &base, opts.engine)
     } else {
         Vec::new()
     };
