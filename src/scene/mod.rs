@@ -230,10 +230,13 @@ impl Scene {
         self.array("materials").get(m)
     }
 
-    /// The UV set the primitive's own material's normal texture reads, if it has one
-    /// (see [`Scene::materials`] for everything else a material reads and needs).
+    /// The UV set the primitive's own material's normal texture reads, if it has one: then the
+    /// set its tangents follow ([`PrimView::tangent_uvs`]). See [`Scene::materials`] for
+    /// everything else a material reads and needs.
     pub fn normal_texcoord(&self, r: PrimRef) -> Option<u32> {
-        self.materials().default_of(self, r)?.texture(Slot::Normal).map(|t| t.tex_coord)
+        let view = PrimView::new(self, &self.materials(), r);
+        let need = view.tangent_need.as_ref().filter(|n| !n.variant && n.need.slot == Slot::Normal);
+        need.map(|_| view.tangent_uvs().set)
     }
 
     /// The transform that the UVs deciding the primitive's tangents go through (the
