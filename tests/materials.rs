@@ -285,6 +285,26 @@ fn a_variant_with_a_normal_texture_gets_tangents_and_keeps_them() {
     assert!(!codes(&r).iter().any(|c| c.starts_with("TANGENT")), "{r:#}");
 }
 
+/// preview draws the frames `tangents` would store, from the same UVs (the one rule of
+/// `scene::view`): where the drawn material needs none but a variant's does, the frame views of
+/// the input follow the variant's UV set, so they show what the output stores, pixel for pixel.
+#[test]
+fn preview_frames_follow_the_uvs_tangents_store() {
+    let d = scratch_dir("materials_variants_preview");
+    let input = variants(&d, "in", None);
+    let out = d.join("out.glb");
+    run_ok(&["tangents", s(&input), "-o", s(&out), "-q"]);
+    assert_tangents(&out, [0.0, 1.0, 0.0, 1.0]);
+    for view in ["tangent", "handedness"] {
+        let picture = |mesh: &Path, name: &str| {
+            let img = d.join(format!("{name}_{view}.png"));
+            run_ok(&["preview", s(mesh), "-o", s(&img), "--size", "48x48", "--view", view, "-q"]);
+            std::fs::read(img).unwrap()
+        };
+        assert!(picture(&input, "input") == picture(&out, "stored"), "--view {view}: input and output differ");
+    }
+}
+
 // ---------- one reading ----------
 
 /// No stage outside `src/scene/` (the model) and `src/format/` (the readers that build it) reads material textures from the JSON: they ask `MaterialInfo`.

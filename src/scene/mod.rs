@@ -13,11 +13,13 @@ pub mod nodes;
 pub mod normals;
 pub mod refs;
 pub mod texcoord;
+pub mod view;
 pub mod weld;
 
 pub use accessor::{Format, Stream};
 pub use material::{Materials, PrimNeed, Slot, TangentNeed, UvTransform};
 pub use normals::{flat_normals, smooth_normals, smooth_vertex_normals};
+pub use view::{Geometry, Mode, PrimView, UvSource};
 
 use crate::error::{Error, Result};
 use accessor::*;
@@ -228,16 +230,19 @@ impl Scene {
         self.array("materials").get(m)
     }
 
-    /// The UV set the primitive's own material's normal texture reads, if it has one
-    /// (see [`Scene::materials`] for everything else a material reads and needs).
+    /// The UV set the primitive's own material's normal texture reads, if it has one: then the
+    /// set its tangents follow ([`PrimView::tangent_uvs`]). See [`Scene::materials`] for
+    /// everything else a material reads and needs.
     pub fn normal_texcoord(&self, r: PrimRef) -> Option<u32> {
-        self.materials().default_of(self, r)?.texture(Slot::Normal).map(|t| t.tex_coord)
+        let view = PrimView::new(self, &self.materials(), r);
+        let need = view.tangent_need.as_ref().filter(|n| !n.variant && n.need.slot == Slot::Normal);
+        need.map(|_| view.tangent_uvs().set)
     }
 
     /// The transform that the UVs deciding the primitive's tangents go through (the
-    /// `KHR_texture_transform` of the texture that needs them), if any.
+    /// `KHR_texture_transform` of the texture that needs them), if any: [`PrimView::tangent_uvs`].
     pub fn normal_uv_transform(&self, r: PrimRef) -> Option<UvTransform> {
-        self.materials().tangent_need(self, r)?.need.transform
+        PrimView::new(self, &self.materials(), r).tangent_uvs().transform
     }
 
     /// The primitive as its accessors declare it, for listing: the same as
@@ -310,7 +315,7 @@ impl Scene {
             }
             None => (0..count as u32).collect(),
         };
-        let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4) as u32;
+        let mode = Mode::of(pj).0 as u32;
         Ok(Primitive { attributes, targets, indices, mode })
     }
 
