@@ -90,7 +90,7 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
             needed_by: uvs.and_then(|u| u.need.as_ref()).map(|n| n.describe()),
             stats: None,
         };
-        match needs_tangents(scene, &mats, r, opts.all) {
+        match needs_tangents(scene, mats, r, opts.all) {
             Err(why) => reports.push(report("skipped", Some(why), None)),
             Ok(uvs) => {
                 let p = crate::scene::to_triangle_list(scene.primitive(r)?);

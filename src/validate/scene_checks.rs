@@ -20,7 +20,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.mesh = Some(r.mesh);
         s.primitive = Some(r.primitive);
         let pj = scene.prim_json(r);
-        check_texcoords(scene, &mats, r, &mut s);
+        check_texcoords(scene, mats, r, &mut s);
         let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
         // A compressed primitive whose normal map needs frames is a warning: its frames go
         // unchecked, and `--strict` must not pass them silently.
@@ -91,7 +91,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     if let Some(s) = check_nodes(scene) {
         done.push(s);
     }
-    done.extend(check_images(scene, &mats));
+    done.extend(check_images(scene, mats));
     Ok(done)
 }
 
