@@ -88,7 +88,7 @@ pub struct ImageInfo {
 pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let scene = Scene::read(path, opts)?;
     let arr = |k: &str| scene.json.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
-    let mats = scene.materials();
+    let mats = scene.materials().clone();
     let mut primitives = Vec::new();
     for view in views(&scene, &mats) {
         let r = view.at;
@@ -100,8 +100,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
             mesh: r.mesh,
             primitive: r.primitive,
             mode: mode.0,
-            // As the file declares it, even when it names no material.
-            material: scene.prim_json(r).get("material").and_then(|m| m.as_u64()).map(|m| m as usize),
+            material: scene.material_index(r),
             vertices: p.vertex_count(),
             triangles: if mode == Mode::TRIANGLES { p.indices.len() / 3 } else { p.indices.len().saturating_sub(2) },
             attributes: p

@@ -8,6 +8,7 @@
 
 pub mod accessor;
 pub(crate) mod compact;
+pub mod leave_out;
 pub mod material;
 pub mod nodes;
 pub mod normals;
@@ -99,6 +100,8 @@ pub struct Scene {
     pub height_maps: Vec<HeightMapRef>,
     /// What compaction and appending did, for the writer's report.
     pub(crate) ledger: compact::Ledger,
+    /// [`Scene::materials`], once read.
+    pub(crate) material_cache: std::sync::OnceLock<material::Materials>,
 }
 
 /// A height map a material wants as its bump map.
@@ -226,8 +229,7 @@ impl Scene {
 
     /// The material JSON of a primitive, if it has one.
     pub fn material_of(&self, r: PrimRef) -> Option<&Value> {
-        let m = self.prim_json(r).get("material")?.as_u64()? as usize;
-        self.array("materials").get(m)
+        self.array("materials").get(self.material_index(r)?)
     }
 
     /// The UV set the primitive's own material's normal texture reads, if it has one: then the

@@ -85,7 +85,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     if let Some(s) = check_nodes(scene) {
         done.push(s);
     }
-    done.extend(check_images(scene, &mats));
+    done.extend(check_images(scene, mats));
     Ok(done)
 }
 
