@@ -236,7 +236,7 @@ impl Scene {
     /// set its tangents follow ([`PrimView::tangent_uvs`]). See [`Scene::materials`] for
     /// everything else a material reads and needs.
     pub fn normal_texcoord(&self, r: PrimRef) -> Option<u32> {
-        let view = PrimView::new(self, &self.materials(), r);
+        let view = PrimView::new(self, self.materials(), r);
         let need = view.tangent_need.as_ref().filter(|n| !n.variant && n.need.slot == Slot::Normal);
         need.map(|_| view.tangent_uvs().set)
     }
@@ -244,7 +244,7 @@ impl Scene {
     /// The transform that the UVs deciding the primitive's tangents go through (the
     /// `KHR_texture_transform` of the texture that needs them), if any: [`PrimView::tangent_uvs`].
     pub fn normal_uv_transform(&self, r: PrimRef) -> Option<UvTransform> {
-        PrimView::new(self, &self.materials(), r).tangent_uvs().transform
+        PrimView::new(self, self.materials(), r).tangent_uvs().transform
     }
 
     /// The primitive as its accessors declare it, for listing: the same as
