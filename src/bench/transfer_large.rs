@@ -57,6 +57,13 @@ pub struct LargeRow {
     /// What the baker's HIGH (tree, positions, triangles, normals) takes alone, per triangle.
     pub high_bytes_per_triangle: f64,
     pub error: Evaluation,
+    /// FNV-1a 64 of OUT: the same HIGH from memory, OBJ and PLY bakes the same bytes.
+    pub out_fingerprint: String,
+    /// Runs of a file row (a memory row runs once); `wall_s` and the stages are medians.
+    pub runs: usize,
+    /// Blender's bake of the same files, interleaved (`--blender`, file rows only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blender: Option<super::blender::BlenderRow>,
     /// The reader alone (`format::raw::read_raw` in the bench's process), for file rows.
     pub reader: Option<ReadTiming>,
 }
@@ -280,6 +287,9 @@ pub fn large_row(
         high_bytes_per_triangle: f64::NAN,
         error: Evaluation::default(),
         reader: None,
+        out_fingerprint: String::new(),
+        runs: 1,
+        blender: None,
     };
     let set_peak = |row: &mut LargeRow, peak: f64, high_bytes: f64| {
         row.peak_mb = peak / 1e6;
@@ -295,6 +305,7 @@ pub fn large_row(
         let tr = r.transfer.ok_or_else(|| Error::usage("bench transfer: the bake made no transfer report"))?;
         let stage = |n: &str| tr.timings_ms.stages.iter().find(|s| s.0 == n).map_or(f64::NAN, |s| s.1);
         row.error = evaluate(&out, &truth, &|_| true)?;
+        row.out_fingerprint = std::fs::read(&out).map(|b| super::fingerprint(&b)).unwrap_or_default();
         let _ = std::fs::remove_file(&out);
         (row.wall_s, row.cpu_s) = (wall, cpu);
         (row.read_high_ms, row.bvh_ms, row.rays_ms) = (stage("read high"), stage("bvh"), stage("rays"));
@@ -317,12 +328,14 @@ pub fn large_row(
         }
         if plan.bake {
             let cpu = cpu_seconds(true);
-            let r = time_one(exe, dir, low, &path, tris, plan.size, 1, 1, &torus)?;
-            row.cpu_s = cpu_seconds(true) - cpu;
+            let r = time_one(exe, dir, low, &path, tris, plan.size, 1, plan.runs, &torus, plan.blender.as_ref())?;
+            // Blender's runs are children too: CPU time is the bake's only without it.
+            row.cpu_s = if plan.blender.is_none() { (cpu_seconds(true) - cpu) / r.runs as f64 } else { f64::NAN };
             (row.wall_s, row.error) = (r.median_s, r.error);
             (row.read_high_ms, row.bvh_ms, row.rays_ms) = (r.read_high_ms, r.bvh_ms, r.rays_ms);
             row.read_mb_s = row.file_mb / r.read_high_ms * 1e3;
             set_peak(&mut row, r.peak_mb * 1e6, r.high_bytes_per_triangle * tris as f64);
+            (row.runs, row.blender, row.out_fingerprint) = (r.runs, r.blender, r.out_fingerprint);
         }
         Ok(())
     })();
@@ -335,11 +348,11 @@ pub fn large_row(
 /// The large rows as a text table.
 pub fn table(rows: &[LargeRow]) -> String {
     let mut s = String::from(
-        "HIGH tris  from     file MB  size  wall s  CPU s  read ms  read MB/s  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°\n",
+        "HIGH tris  from     file MB  size  wall s  CPU s  read ms  read MB/s  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°  OUT\n",
     );
     for r in rows {
         s += &format!(
-            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>6.2} {:>8.0} {:>10.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}\n",
+            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>6.2} {:>8.0} {:>10.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}  {}\n",
             r.high_triangles,
             format!("{:?}", r.source).to_lowercase(),
             r.file_mb,
@@ -354,8 +367,28 @@ pub fn table(rows: &[LargeRow]) -> String {
             r.bytes_per_triangle,
             r.high_bytes_per_triangle,
             r.error.synced.mean,
-            r.error.synced.p99
+            r.error.synced.p99,
+            &r.out_fingerprint[..r.out_fingerprint.len().min(8)]
         );
+    }
+    for r in rows {
+        if let Some(b) = &r.blender {
+            s += &format!(
+                "Blender {} on the same {} ({} triangles), {} runs: median {:.2} s ({:.2}-{:.2}; import {:.2} s, bake {:.2} s), peak {:.0} MB: bumpbake {:.1}x faster, {:.1}x less memory\n",
+                b.version,
+                format!("{:?}", r.source).to_uppercase(),
+                r.high_triangles,
+                b.runs,
+                b.median_s,
+                b.min_s,
+                b.max_s,
+                b.import_high_s,
+                b.bake_s,
+                b.peak_mb,
+                b.ratio,
+                b.peak_mb / r.peak_mb
+            );
+        }
     }
     let timed: Vec<&LargeRow> = rows.iter().filter(|r| r.reader.is_some()).collect();
     if !timed.is_empty() {
@@ -386,6 +419,10 @@ pub struct Plan {
     pub millions: Vec<f64>,
     pub sources: Vec<Source>,
     pub size: usize,
+    /// Runs of each file row (medians reported).
+    pub runs: usize,
+    /// Blender's bake of each file row's files, interleaved with bumpbake's runs.
+    pub blender: Option<super::blender::Blender>,
     /// Runs of the reader alone on each file row (0: none).
     pub read_runs: usize,
     /// Whether to bake (false: only the reader is timed).

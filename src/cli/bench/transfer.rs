@@ -8,6 +8,7 @@ use bumpbake::{Error, Result};
   bumpbake bench transfer
   bumpbake bench transfer --runs 7 --json > transfer-bench.json
   bumpbake bench transfer --runs 0 --large 10 --large-from memory,obj
+  bumpbake bench transfer --runs 0 --large 10.24 --large-from obj --large-runs 3 --blender python3
   bumpbake bench transfer --runs 0 --large 2 --large-from obj,ply --large-size 256
   bumpbake bench transfer --runs 0 --large 2 --large-from obj,ply --read-only --keep /tmp/high")]
 pub struct BenchTransferArgs {
@@ -29,6 +30,13 @@ pub struct BenchTransferArgs {
     /// Map size of the large rows.
     #[arg(long, default_value_t = 2048)]
     pub large_size: usize,
+    /// Runs of each large row read from a file (medians reported); memory rows run once.
+    #[arg(long, default_value_t = 1)]
+    pub large_runs: usize,
+    /// A Python that imports `bpy` (Blender as a module): Blender bakes each large file row's
+    /// files too, interleaved with bumpbake's runs, and the row gives the ratio.
+    #[arg(long, value_name = "PYTHON")]
+    pub blender: Option<std::path::PathBuf>,
     /// Also time the reader alone (`read_raw`, in this process) this many times on each large
     /// row's OBJ or PLY file, for its MB/s.
     #[arg(long, default_value_t = 3)]
@@ -76,10 +84,13 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
     if !(1..=8192).contains(&a.large_size) {
         return Err(Error::usage("--large-size: 1 to 8192 texels"));
     }
+    let blender = a.blender.clone().map(|python| bumpbake::bench::blender::Blender { python });
     let plan = Plan {
         millions,
         sources,
         size: a.large_size,
+        runs: a.large_runs.max(1),
+        blender,
         read_runs: a.large_read,
         bake: !a.read_only,
         keep: a.keep.is_some(),
