@@ -91,14 +91,19 @@ fn parse_with<const FAST: bool>(path: &Path, mut r: impl Read, piece: usize) -> 
     let piece = piece.max(1);
     let block = piece * PIECES_PER_BLOCK;
     let mut acc = Acc::default();
+    // `buf[..kept]` holds what the last block left (a line not yet ended); the buffer keeps its
+    // length between blocks, so it is zeroed once, not at every block.
     let mut buf: Vec<u8> = Vec::new();
+    let mut kept = 0;
     let mut eof = false;
     let mut first = true;
     while !eof {
         // Fill the buffer to a block (more when one line is longer than a block).
-        let want = buf.len() + block;
-        let mut filled = buf.len();
-        buf.resize(want, 0);
+        let want = kept + block;
+        let mut filled = kept;
+        if buf.len() < want {
+            buf.resize(want, 0);
+        }
         while filled < want {
             match r.read(&mut buf[filled..]) {
                 Ok(0) => {
@@ -110,12 +115,13 @@ fn parse_with<const FAST: bool>(path: &Path, mut r: impl Read, piece: usize) -> 
                 Err(e) => return Err(Error::input(path, format!("cannot read: {e}"))),
             }
         }
-        buf.truncate(filled);
-        let start = if first && buf.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
+        let data = &buf[..filled];
+        let start = if first && data.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
         first = false;
-        let cut = if eof { buf.len() } else { buf.iter().rposition(|&c| c == b'\n').map_or(start, |i| i + 1) };
-        acc.block::<FAST>(path, &buf[start..cut], piece)?;
-        buf.drain(..cut);
+        let cut = if eof { filled } else { data.iter().rposition(|&c| c == b'\n').map_or(start, |i| i + 1) };
+        acc.block::<FAST>(path, &data[start..cut], piece)?;
+        buf.copy_within(cut..filled, 0);
+        kept = filled - cut;
     }
     acc.finish(path)
 }
