@@ -3,7 +3,8 @@
 
 use crate::error::Result;
 use crate::scene::material::TextureUse;
-use crate::scene::{ReadOptions, Scene, Slot};
+use crate::scene::view::views;
+use crate::scene::{Mode, ReadOptions, Scene, Slot};
 use crate::tangent::apply::needs_tangents;
 use serde::Serialize;
 use serde_json::Value;
@@ -87,21 +88,21 @@ pub struct ImageInfo {
 pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let scene = Scene::read(path, opts)?;
     let arr = |k: &str| scene.json.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
-    let mats = scene.materials();
+    let mats = scene.materials().clone();
     let mut primitives = Vec::new();
-    for r in scene.primitives() {
-        let pj = scene.prim_json(r).clone();
+    for view in views(&scene, &mats) {
+        let r = view.at;
         let p = scene.declared_primitive(r)?;
-        let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
-        let need = needs_tangents(&scene, &mats, r, false);
-        let by = need.as_ref().ok().and_then(|u| u.need.as_ref());
+        let mode = view.mode;
+        let need = needs_tangents(&view, false).map(|()| view.tangent_uvs());
+        let by = need.as_ref().ok().and(view.tangent_need.as_ref());
         primitives.push(PrimInfo {
             mesh: r.mesh,
             primitive: r.primitive,
-            mode,
-            material: pj.get("material").and_then(|m| m.as_u64()).map(|m| m as usize),
+            mode: mode.0,
+            material: scene.material_index(r),
             vertices: p.vertex_count(),
-            triangles: if mode == 4 { p.indices.len() / 3 } else { p.indices.len().saturating_sub(2) },
+            triangles: if mode == Mode::TRIANGLES { p.indices.len() / 3 } else { p.indices.len().saturating_sub(2) },
             attributes: p
                 .attributes
                 .iter()
@@ -114,7 +115,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
                 .collect(),
             morph_targets: p.targets.len(),
             has_tangents: p.attr("TANGENT").is_some(),
-            tangents_needed_from: need.as_ref().ok().map(|u| format!("TEXCOORD_{}", u.set)),
+            tangents_needed_from: need.as_ref().ok().map(|u| u.attribute()),
             tangents_needed_by: by.map(|n| n.describe()),
             tangent_conflicts: by.map(|n| n.conflicts.clone()).unwrap_or_default(),
             tangents_not_needed: need.err(),

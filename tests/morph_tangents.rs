@@ -147,3 +147,39 @@ fn targets_of_a_primitive_without_normals() {
         assert!(close(*t, want, 2e-6), "corner {c}: {t:?}, expected {want:?}");
     }
 }
+
+/// A normal texture read through KHR_texture_transform: the base frames follow the transformed
+/// UVs, and so do the morphed ones. A target that only lifts the surface (no turn, no UV change)
+/// leaves every frame as it was: zero deltas. The rotation by pi/2 turns the tangent from +u to
+/// -v of the stored UVs (docs/conventions.md).
+#[test]
+fn morphed_frames_follow_the_texture_transform_too() {
+    let d = scratch_dir("morph_transform_in");
+    let v = validated_dir("morph_transform");
+    let (pos, nrm, uv, idx) = grid(3);
+    let lift = vec![[0.0, 0.0, 0.5f32]; pos.len()];
+    let mut g = Gltf::new();
+    let attrs = json!({
+        "POSITION": g.floats(&pos, Some(34962)),
+        "NORMAL": g.floats(&nrm, Some(34962)),
+        "TEXCOORD_0": g.floats(&uv, Some(34962)),
+    });
+    let targets = json!([{ "POSITION": g.floats(&lift, Some(34962)) }]);
+    let i = g.indices(&idx);
+    let tex = g.texture();
+    let transform = json!({ "KHR_texture_transform": { "rotation": std::f64::consts::FRAC_PI_2 } });
+    let m = g.material(json!({ "normalTexture": { "index": tex, "extensions": transform } }));
+    g.mesh(json!({ "attributes": attrs, "indices": i, "material": m, "targets": targets }));
+    g.json["extensionsUsed"] = json!(["KHR_texture_transform"]);
+    let input = d.join("transform.glb");
+    g.write_glb(&input);
+    let out = v.join("transform.glb");
+    run_ok(&["tangents", s(&input), "-o", s(&out), "-q"]);
+    let scene = load(&out);
+    let base = corner_attr::<4>(&scene, P0, "TANGENT");
+    let delta = target_corners::<3>(&scene, 0, "TANGENT");
+    for (c, (t, dt)) in base.iter().zip(&delta).enumerate() {
+        assert!(close([t[0], t[1], t[2]], [0.0, -1.0, 0.0], 1e-6), "base corner {c}: {t:?}");
+        assert!(close(*dt, [0.0; 3], 1e-6), "corner {c}: delta {dt:?} for a target that turns nothing");
+    }
+}

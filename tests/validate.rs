@@ -311,6 +311,34 @@ fn mirrored_instance_is_info() {
     assert_eq!(finding(&r, "NODE_MIRRORED")["examples"][0]["index"], 0);
 }
 
+/// The mirror check walks the nodes the default scene shows, as preview and `bake --from` place
+/// meshes (`scene::nodes`): a mirroring node that only another scene shows is not drawn, so not
+/// counted; a mirroring node in the default scene is, with its parent chain.
+#[test]
+fn mirror_check_walks_the_default_scene() {
+    let d = scratch_dir("validate_node_mirror_scenes");
+    let mut g = Gltf::new();
+    let p = grid_prim();
+    let attrs = attrs_of(&mut g, &p);
+    let i = g.indices(&p.idx);
+    let tex = texture_of(&mut g, &bumpy(false));
+    let m = g.material(json!({ "normalTexture": { "index": tex } }));
+    g.mesh(json!({ "attributes": attrs, "indices": i, "material": m, "name": "quad" }));
+    let nodes = g.json["nodes"].as_array_mut().unwrap();
+    nodes.push(json!({ "name": "mirror", "scale": [-1.0, 1.0, 1.0], "children": [0] }));
+    nodes.push(json!({ "name": "other scene", "scale": [1.0, 1.0, -1.0], "mesh": 0 }));
+    nodes.push(json!({ "name": "plain", "mesh": 0, "translation": [3.0, 0.0, 0.0] }));
+    g.json["scenes"] = json!([{ "nodes": [1, 3] }, { "nodes": [2] }]);
+    let path = d.join("scenes.glb");
+    g.write_glb(&path);
+    let (code, r) = validate(&[s(&path), "--strict"]);
+    assert_only(&r, "NODE_MIRRORED", "info");
+    assert_eq!(code, 0);
+    let f = finding(&r, "NODE_MIRRORED");
+    assert_eq!((f["count"].as_u64(), f["total"].as_u64()), (Some(1), Some(2)), "{f:#}");
+    assert_eq!(f["examples"][0]["index"], 0);
+}
+
 #[test]
 fn non_triangle_primitive_is_not_checked_info() {
     let d = scratch_dir("validate_lines");

@@ -166,9 +166,7 @@ pub fn from_scene(scene: &Scene) -> Result<RawMesh> {
         for k in 0..prims {
             let r = PrimRef { mesh: inst.mesh, primitive: k };
             let pj = scene.prim_json(r);
-            if !(4..=6).contains(&pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4))
-                || pj.pointer("/attributes/POSITION").is_none()
-            {
+            if !crate::scene::Mode::of(pj).has_triangles() || pj.pointer("/attributes/POSITION").is_none() {
                 continue;
             }
             let p = to_triangle_list(scene.primitive(r)?);

@@ -3,16 +3,18 @@
 //!
 //! Everything a renderer would otherwise have to guess is settled here, the way the conventions
 //! say a client should: missing normals become flat normals, missing tangents become MikkTSpace
-//! tangents (the same code `bumpbake tangents` runs), OBJ UVs are flipped to glTF's v-down, and a
-//! node transform that mirrors flips both the winding and `w`, so that `B = cross(N, T) * w`
-//! still points where the texture's +v-up axis lies on the surface.
+//! tangents (the same code and the same UVs `bumpbake tangents` uses), and a node transform that
+//! mirrors flips both the winding and `w`, so that `B = cross(N, T) * w` still points where the
+//! texture's +v-up axis lies on the surface. What the values are, which UVs the frames follow and
+//! where each primitive is shown come from the scene's view ([`crate::scene::view`]).
 
 use super::texture::{Sampler, Texture};
 use crate::error::Result;
 use crate::scene::material::{MaterialInfo, TextureUse};
 use crate::scene::nodes::{instances, Instance};
-use crate::scene::{flat_normals, Materials, PrimRef, Scene, Slot, UvTransform};
-use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use crate::scene::view::views;
+use crate::scene::{flat_normals, Geometry, Materials, Mode, PrimRef, PrimView, Scene, Slot, UvSource, UvTransform};
+use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -103,31 +105,28 @@ impl Prepared {
     pub fn with_frames(scene: &Scene, all_frames: bool) -> Result<Prepared> {
         let mut cx = Cx {
             scene,
-            mats: scene.materials(),
+            mats: scene.materials().clone(),
             all_frames,
             textures: HashMap::new(),
             materials: Vec::new(),
             material_index: HashMap::new(),
             notes: Vec::new(),
         };
+        let views = views(scene, &cx.mats);
+        let mut of_mesh: HashMap<usize, Vec<&PrimView>> = HashMap::new();
+        views.iter().for_each(|v| of_mesh.entry(v.at.mesh).or_default().push(v));
         let mut draws = Vec::new();
         let mut prim_cache: HashMap<PrimRef, Option<Local>> = HashMap::new();
-        for Instance { mesh, world, .. } in instances(scene) {
-            let n = scene
-                .json
-                .pointer(&format!("/meshes/{mesh}/primitives"))
-                .and_then(|p| p.as_array())
-                .map(|a| a.len())
-                .unwrap_or(0);
-            for p in 0..n {
-                let r = PrimRef { mesh, primitive: p };
+        for inst in instances(scene) {
+            for &view in of_mesh.get(&inst.mesh).into_iter().flatten() {
+                let r = view.at;
                 if let std::collections::hash_map::Entry::Vacant(e) = prim_cache.entry(r) {
-                    let local = cx.local(r)?;
+                    let local = cx.local(view)?;
                     e.insert(local);
                 }
                 if let Some(Some(local)) = prim_cache.get(&r) {
                     let material = cx.material(r)?;
-                    draws.push(place(local, world, material, r));
+                    draws.push(place(local, &inst, material, r));
                 }
             }
         }
@@ -176,48 +175,48 @@ struct Cx<'a> {
 }
 
 impl Cx<'_> {
-    fn local(&mut self, r: PrimRef) -> Result<Option<Local>> {
+    fn local(&mut self, view: &PrimView) -> Result<Option<Local>> {
         let s = self.scene;
-        let mut prim = s.primitive(r)?;
+        let r = view.at;
+        let mut g = view.read(s)?;
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
-        if prim.mode != 4 {
-            self.notes.push(format!("{where_}: mode {} is not a triangle list; not drawn", prim.mode));
+        if view.mode != Mode::TRIANGLES {
+            self.notes.push(format!("{where_}: mode {} is not a triangle list; not drawn", view.mode));
             return Ok(None);
         }
-        if prim.attr("POSITION").is_none() {
+        if g.primitive.attr("POSITION").is_none() {
             self.notes.push(format!("{where_}: no POSITION; not drawn"));
             return Ok(None);
         }
-        // The preview draws the primitive's own material: its need decides the frames.
-        let need = self.mats.default_of(s, r).and_then(|m| m.tangents()).cloned();
-        let uv_set = need.as_ref().map_or(0, |n| n.tex_coord);
-        let uv_name = format!("TEXCOORD_{uv_set}");
-        let tangents_ok = prim.attr("TANGENT").map(|t| t.format.components() == 4).unwrap_or(false);
-        let has_map = need.is_some();
-        if !tangents_ok && (has_map || self.all_frames) && prim.attr(&uv_name).is_some() && prim.indices.len() >= 3 {
-            prim.indices.truncate(prim.indices.len() / 3 * 3);
+        // Frames are made where the material drawn (the primitive's own) needs them, from the UVs
+        // `bumpbake tangents` would use.
+        let uvs = view.tangent_uvs();
+        let has_map = view.own_material_needs_tangents();
+        let tangents_ok = g.primitive.attr("TANGENT").map(|t| t.format.components() == 4).unwrap_or(false);
+        if !tangents_ok
+            && (has_map || self.all_frames)
+            && g.primitive.attr(&uvs.attribute()).is_some()
+            && g.primitive.indices.len() >= 3
+        {
             // Exactly what `bumpbake tangents` would store, so the preview shows the tool's frames.
-            let transform = need.as_ref().and_then(|n| n.transform);
-            prim = crate::tangent::primitive_with_uvs(prim, uv_set, transform.as_ref(), &Default::default()).0;
+            g = Geometry::new(crate::tangent::with_frames(g, &Default::default()).0, uvs);
             if has_map {
                 self.notes
-                    .push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{uv_set}"));
+                    .push(format!("{where_}: no TANGENT; drew it with MikkTSpace tangents from TEXCOORD_{}", uvs.set));
             }
         }
-        let mut positions: Vec<Vec3> = prim.positions().into_iter().map(Vec3::from).collect();
-        let mut normals: Option<Vec<Vec3>> =
-            prim.attr("NORMAL").map(|n| n.to_f32::<3>().into_iter().map(Vec3::from).collect());
-        let mut tangents: Option<Vec<Vec4>> = prim
-            .attr("TANGENT")
-            .filter(|t| t.format.components() == 4)
-            .map(|t| t.to_f32::<4>().into_iter().map(Vec4::from).collect());
+        let mut positions: Vec<Vec3> = g.positions().iter().map(|&p| Vec3::from(p)).collect();
+        let mut normals: Option<Vec<Vec3>> = g.normals().map(|n| n.iter().map(|&v| Vec3::from(v)).collect());
+        let vec4 = g.primitive.attr("TANGENT").is_some_and(|t| t.format.components() == 4);
+        let mut tangents: Option<Vec<Vec4>> =
+            g.tangents().filter(|_| vec4).map(|t| t.into_iter().map(Vec4::from).collect());
         let uv = |k: u32| -> Vec<Vec2> {
-            prim.attr(&format!("TEXCOORD_{k}"))
-                .map(|t| t.to_f32::<2>().into_iter().map(Vec2::from).collect())
+            g.uvs(UvSource { set: k, transform: None })
+                .map(|t| t.iter().map(|&v| Vec2::from(v)).collect())
                 .unwrap_or_default()
         };
         let mut uvs = [uv(0), uv(1)];
-        let mut indices = prim.indices.clone();
+        let mut indices = g.primitive.indices.clone();
         indices.truncate(indices.len() / 3 * 3);
 
         if normals.is_none() {
@@ -315,23 +314,18 @@ impl Cx<'_> {
     }
 }
 
-fn place(l: &Local, world: Mat4, material: usize, source: PrimRef) -> Draw {
-    let m3 = Mat3::from_mat4(world);
-    let det = m3.determinant();
-    let nm = if det.abs() > 1e-30 && det.is_finite() { m3.inverse().transpose() } else { m3 };
-    let mirror = det < 0.0;
-    let positions = l.positions.iter().map(|&p| world.transform_point3(p)).collect();
+fn place(l: &Local, inst: &Instance, material: usize, source: PrimRef) -> Draw {
+    let (m3, nm) = (inst.tangent_matrix(), inst.normal_matrix());
+    let positions = l.positions.iter().map(|&p| inst.world.transform_point3(p)).collect();
     let normals: Vec<Vec3> = l.normals.iter().map(|&n| unit_or(nm * n, Vec3::Z)).collect();
     let tangents = l
         .tangents
         .iter()
         .zip(&normals)
-        .map(|(&t, &n)| {
-            let w = if mirror { -t.w } else { t.w };
-            sane_tangent((m3 * t.truncate()).extend(w), n)
-        })
+        .map(|(&t, &n)| sane_tangent((m3 * t.truncate()).extend(inst.world_w(t.w)), n))
         .collect();
-    let triangles = if mirror { l.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect() } else { l.triangles.clone() };
+    let triangles =
+        if inst.mirrored() { l.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect() } else { l.triangles.clone() };
     Draw { positions, normals, tangents, uvs: l.uvs.clone(), triangles, material, source }
 }
 

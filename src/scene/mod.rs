@@ -8,16 +8,19 @@
 
 pub mod accessor;
 pub(crate) mod compact;
+pub mod leave_out;
 pub mod material;
 pub mod nodes;
 pub mod normals;
 pub mod refs;
 pub mod texcoord;
+pub mod view;
 pub mod weld;
 
 pub use accessor::{Format, Stream};
 pub use material::{Materials, PrimNeed, Slot, TangentNeed, UvTransform};
 pub use normals::{flat_normals, smooth_normals, smooth_vertex_normals};
+pub use view::{Geometry, Mode, PrimView, UvSource};
 
 use crate::error::{Error, Result};
 use accessor::*;
@@ -97,6 +100,8 @@ pub struct Scene {
     pub height_maps: Vec<HeightMapRef>,
     /// What compaction and appending did, for the writer's report.
     pub(crate) ledger: compact::Ledger,
+    /// [`Scene::materials`], once read.
+    pub(crate) material_cache: std::sync::OnceLock<material::Materials>,
 }
 
 /// A height map a material wants as its bump map.
@@ -224,20 +229,22 @@ impl Scene {
 
     /// The material JSON of a primitive, if it has one.
     pub fn material_of(&self, r: PrimRef) -> Option<&Value> {
-        let m = self.prim_json(r).get("material")?.as_u64()? as usize;
-        self.array("materials").get(m)
+        self.array("materials").get(self.material_index(r)?)
     }
 
-    /// The UV set the primitive's own material's normal texture reads, if it has one
-    /// (see [`Scene::materials`] for everything else a material reads and needs).
+    /// The UV set the primitive's own material's normal texture reads, if it has one: then the
+    /// set its tangents follow ([`PrimView::tangent_uvs`]). See [`Scene::materials`] for
+    /// everything else a material reads and needs.
     pub fn normal_texcoord(&self, r: PrimRef) -> Option<u32> {
-        self.materials().default_of(self, r)?.texture(Slot::Normal).map(|t| t.tex_coord)
+        let view = PrimView::new(self, self.materials(), r);
+        let need = view.tangent_need.as_ref().filter(|n| !n.variant && n.need.slot == Slot::Normal);
+        need.map(|_| view.tangent_uvs().set)
     }
 
     /// The transform that the UVs deciding the primitive's tangents go through (the
-    /// `KHR_texture_transform` of the texture that needs them), if any.
+    /// `KHR_texture_transform` of the texture that needs them), if any: [`PrimView::tangent_uvs`].
     pub fn normal_uv_transform(&self, r: PrimRef) -> Option<UvTransform> {
-        self.materials().tangent_need(self, r)?.need.transform
+        PrimView::new(self, self.materials(), r).tangent_uvs().transform
     }
 
     /// The primitive as its accessors declare it, for listing: the same as
@@ -310,7 +317,7 @@ impl Scene {
             }
             None => (0..count as u32).collect(),
         };
-        let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4) as u32;
+        let mode = Mode::of(pj).0 as u32;
         Ok(Primitive { attributes, targets, indices, mode })
     }
 

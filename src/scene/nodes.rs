@@ -1,7 +1,7 @@
 //! The node tree, walked one way for every stage: which meshes a scene shows and where.
 
 use super::Scene;
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat3, Mat4, Quat, Vec3};
 use serde_json::Value;
 
 /// One place a mesh is shown.
@@ -15,10 +15,38 @@ pub struct Instance {
 }
 
 impl Instance {
+    /// The matrix directions on the surface (tangents) go through: the world matrix without its
+    /// translation. Renderers normalise what comes out.
+    pub fn tangent_matrix(&self) -> Mat3 {
+        Mat3::from_mat4(self.world)
+    }
+
+    /// The matrix normals go through: the inverse transpose of [`Self::tangent_matrix`] (itself
+    /// when that cannot be inverted), so normals stay normal to a non-uniformly scaled surface.
+    pub fn normal_matrix(&self) -> Mat3 {
+        let m3 = self.tangent_matrix();
+        let det = m3.determinant();
+        if det.abs() > 1e-30 && det.is_finite() {
+            m3.inverse().transpose()
+        } else {
+            m3
+        }
+    }
+
     /// Whether this instance mirrors its mesh (negative determinant), flipping winding and the
     /// bitangent sign a renderer must use.
     pub fn mirrored(&self) -> bool {
-        self.world.determinant() < 0.0
+        self.tangent_matrix().determinant() < 0.0
+    }
+
+    /// The handedness `w` of a frame as the world sees it: negated on a mirroring instance, so
+    /// that `B = cross(N, T) * w` still points along the texture's +v.
+    pub fn world_w(&self, w: f32) -> f32 {
+        if self.mirrored() {
+            -w
+        } else {
+            w
+        }
     }
 }
 

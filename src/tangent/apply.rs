@@ -3,12 +3,13 @@
 //! Like gltfpack's `needsTangents`, the material decides: a triangle primitive gets frames when a
 //! material it can show (its own, or one a `KHR_materials_variants` mapping switches to) has a
 //! normal texture, a clearcoat normal texture or anisotropy, from the UVs that texture reads,
-//! transformed as `KHR_texture_transform` says. Everything else is skipped with a reason the report
-//! names.
+//! transformed as `KHR_texture_transform` says (the one rule, [`PrimView::tangent_uvs`]).
+//! Everything else is skipped with a reason the report names.
 
-use super::{primitive_with_uvs, FrameStats, Options};
+use super::{with_frames, FrameStats, Options};
 use crate::error::Result;
-use crate::scene::{Materials, PrimNeed, PrimRef, Primitive, Scene, UvTransform};
+use crate::scene::view::{views, PrimView};
+use crate::scene::{Geometry, PrimRef, Primitive, Scene};
 use rayon::prelude::*;
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -36,71 +37,61 @@ pub struct PrimReport {
     pub stats: Option<FrameStats>,
 }
 
-/// The UVs a primitive's tangents follow.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TangentUvs {
-    pub set: u32,
-    pub transform: Option<UvTransform>,
-    /// What needs them; None with `--all` where no material does.
-    pub need: Option<PrimNeed>,
-}
-
-/// Why a primitive needs no tangents, or the UVs it needs them from.
-pub fn needs_tangents(
-    scene: &Scene,
-    mats: &Materials,
-    r: PrimRef,
-    all: bool,
-) -> std::result::Result<TangentUvs, String> {
-    let pj = scene.prim_json(r);
-    let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
-    if !(4..=6).contains(&mode) {
-        return Err(format!("not triangles (mode {mode})"));
+/// Why a primitive gets no tangents, or `Ok` when it gets them (from [`PrimView::tangent_uvs`]).
+/// With `all`, a primitive nothing needs tangents for gets them from set 0.
+pub fn needs_tangents(view: &PrimView, all: bool) -> std::result::Result<(), String> {
+    if !view.mode.has_triangles() {
+        return Err(format!("not triangles (mode {})", view.mode));
     }
-    if pj.pointer("/attributes/POSITION").is_none() {
+    if !view.has_position {
         // glTF lets a primitive leave POSITION out (clients skip drawing it); there is no surface.
         return Err("no POSITION (nothing to draw)".into());
     }
-    let uvs = match mats.tangent_need(scene, r) {
-        Some(need) => TangentUvs { set: need.need.tex_coord, transform: need.need.transform, need: Some(need) },
-        None if all => TangentUvs { set: 0, transform: None, need: None },
-        None if mats.default_of(scene, r).is_none() => return Err("no material".into()),
+    match &view.tangent_need {
+        Some(_) => {}
+        None if all => {}
+        None if view.material.is_none() => return Err("no material".into()),
         None => return Err("material has no normal texture".into()),
-    };
-    if pj.pointer(&format!("/attributes/TEXCOORD_{}", uvs.set)).is_none() {
-        let what =
-            uvs.need.as_ref().map(|n| n.describe()).unwrap_or_else(|| format!("TEXCOORD_{} --all reads", uvs.set));
+    }
+    let uvs = view.tangent_uvs();
+    if !view.has(&uvs.attribute()) {
+        let what = view
+            .tangent_need
+            .as_ref()
+            .map(|n| n.describe())
+            .unwrap_or_else(|| format!("TEXCOORD_{} --all reads", uvs.set));
         return Err(format!("no UVs (the {what}, which the primitive does not have)"));
     }
-    Ok(uvs)
+    Ok(())
 }
 
 /// Gives every primitive that needs them MikkTSpace tangents; returns a report per primitive.
 pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> {
     let mut reports = Vec::new();
-    let mut work: Vec<(PrimRef, TangentUvs, Primitive)> = Vec::new();
-    let mats = scene.materials();
-    for r in scene.primitives() {
-        let report = |action, reason: Option<String>, uvs: Option<&TangentUvs>| PrimReport {
+    let mut work: Vec<(PrimRef, Geometry)> = Vec::new();
+    let mats = scene.materials().clone();
+    for view in views(scene, &mats) {
+        let r = view.at;
+        let report = |action, reason: Option<String>, with_uvs: bool| PrimReport {
             mesh: r.mesh,
             primitive: r.primitive,
             action,
             reason,
-            uv_set: uvs.map(|u| u.set),
-            needed_by: uvs.and_then(|u| u.need.as_ref()).map(|n| n.describe()),
+            uv_set: with_uvs.then(|| view.tangent_uvs().set),
+            needed_by: view.tangent_need.as_ref().filter(|_| with_uvs).map(|n| n.describe()),
             stats: None,
         };
-        match needs_tangents(scene, &mats, r, opts.all) {
-            Err(why) => reports.push(report("skipped", Some(why), None)),
-            Ok(uvs) => {
-                let p = crate::scene::to_triangle_list(scene.primitive(r)?);
-                let why = match p.attr("TANGENT") {
+        match needs_tangents(&view, opts.all) {
+            Err(why) => reports.push(report("skipped", Some(why), false)),
+            Ok(()) => {
+                let g = view.read(scene)?;
+                let why = match g.primitive.attr("TANGENT") {
                     Some(t) if !opts.overwrite => match invalid_tangents(t) {
                         0 => {
                             reports.push(report(
                                 "kept",
                                 Some("valid tangents already present (--overwrite replaces them)".into()),
-                                Some(&uvs),
+                                true,
                             ));
                             continue;
                         }
@@ -109,20 +100,17 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> 
                     Some(_) => Some("existing tangents replaced (--overwrite)".into()),
                     None => None,
                 };
-                let conflicts = uvs.need.iter().flat_map(|n| n.conflicts.iter().cloned());
+                let conflicts = view.tangent_need.iter().flat_map(|n| n.conflicts.iter().cloned());
                 let why = why.into_iter().chain(conflicts).collect::<Vec<_>>();
-                reports.push(report("generated", (!why.is_empty()).then(|| why.join("; ")), Some(&uvs)));
-                work.push((r, uvs, p));
+                reports.push(report("generated", (!why.is_empty()).then(|| why.join("; ")), true));
+                work.push((r, g));
             }
         }
     }
     // The decoded copies are all that is needed now: free the bytes they came from.
     let refs: Vec<PrimRef> = work.iter().map(|w| w.0).collect();
     scene.release_primitives(&refs);
-    let done: Vec<(Primitive, FrameStats)> = work
-        .into_par_iter()
-        .map(|(_, uvs, p)| primitive_with_uvs(p, uvs.set, uvs.transform.as_ref(), &opts.frames))
-        .collect();
+    let done: Vec<(Primitive, FrameStats)> = work.into_par_iter().map(|(_, g)| with_frames(g, &opts.frames)).collect();
     for (r, (p, stats)) in refs.iter().zip(done) {
         scene.put_primitive(*r, p);
         if let Some(rep) = reports.iter_mut().find(|x| x.mesh == r.mesh && x.primitive == r.primitive) {

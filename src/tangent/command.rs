@@ -49,10 +49,10 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     }
     t.time("write", || files.commit())?;
     crate::report::mem_mark("write");
-    let mut notes = scene.notes;
+    let mut notes = std::mem::take(&mut scene.notes);
     // `bake` converts these; `tangents` leaves them, and says so.
     for h in &scene.height_maps {
-        let name = scene.json.pointer(&format!("/materials/{}/name", h.material)).and_then(|n| n.as_str());
+        let name = scene.materials().get(h.material).and_then(|m| m.name.as_deref());
         notes.push(format!(
             "material '{}': bump map '{}' is a height map, left out; `bumpbake bake` converts it to a normal map",
             name.unwrap_or("(unnamed)"),

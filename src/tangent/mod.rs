@@ -12,11 +12,12 @@ pub mod frames;
 pub mod mikk;
 mod morph;
 
-use crate::format::dequant;
 use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
-use crate::scene::{flat_normals, Primitive, UvTransform};
+use crate::scene::{flat_normals, Geometry, Primitive, UvSource};
 use fallback::FallbackCounts;
 use glam::Vec3;
+
+pub use crate::scene::view::gltf_w;
 
 /// An indexed triangle list as MikkTSpace sees it: one normal and one UV per vertex.
 #[derive(Debug, Clone, Copy)]
@@ -47,13 +48,6 @@ pub struct FrameStats {
     pub fallback: FallbackCounts,
 }
 
-/// The `w` glTF stores for MikkTSpace's reference sign: its negation. The reference calls a
-/// triangle orientation-preserving when its UVs wind counter-clockwise with v up; glTF's UVs run
-/// v down, which turns every winding over (docs/conventions.md). The one place this rule lives.
-pub fn gltf_w(reference_w: f32) -> f32 {
-    -reference_w
-}
-
 /// [`gltf_w`] on every frame.
 fn to_gltf_w(frames: &mut frames::Frames) {
     frames.values.iter_mut().for_each(|t| t[3] = gltf_w(t[3]));
@@ -68,67 +62,63 @@ pub fn primitive_with_tangents(p: Primitive, uv_set: u32, opts: &Options) -> Pri
 /// [`primitive_with_tangents`], with what it did. Takes the primitive by value so that each of
 /// its streams can be freed as soon as the output's copy of it is made.
 pub fn primitive_with_stats(p: Primitive, uv_set: u32, opts: &Options) -> (Primitive, FrameStats) {
-    primitive_with_uvs(p, uv_set, None, opts)
+    with_frames(Geometry::new(p, UvSource { set: uv_set, transform: None }), opts)
 }
 
-/// [`primitive_with_stats`] for a texture read through `KHR_texture_transform`: the frames follow
-/// the transformed UVs (the ones the renderer samples with), while the stored UVs stay as they are.
-pub fn primitive_with_uvs(
-    p: Primitive,
-    uv_set: u32,
-    transform: Option<&UvTransform>,
-    opts: &Options,
-) -> (Primitive, FrameStats) {
+/// The primitive of `g` with MikkTSpace tangents from the UVs its tangents follow
+/// ([`Geometry::tangent_uvs`]): through a `KHR_texture_transform` the frames follow the
+/// transformed UVs (the ones the renderer samples with), while the stored UVs stay as they are.
+/// `g` must be a triangle list; its old TANGENT is replaced.
+pub fn with_frames(g: Geometry, opts: &Options) -> (Primitive, FrameStats) {
+    let p = &g.primitive;
     let vertices_in = p.vertex_count();
     let triangles = p.indices.len() / 3;
     let generated_normals = p.attr("NORMAL").is_none();
-    let (plan, fallback) = split_plan(&p, uv_set, transform, opts);
-    let mut out = plan.apply(p);
+    let (plan, fallback) = split_plan(&g, opts);
+    let mut out = plan.apply(g.primitive);
     out.mode = 4;
     crate::report::mem_mark("split");
     let stats = FrameStats { vertices_in, vertices_out: out.vertex_count(), triangles, generated_normals, fallback };
     (out, stats)
 }
 
-/// Frames for every corner of `p`, repaired, and the vertices and streams they make: everything
+/// Frames for every corner of `g`, repaired, and the vertices and streams they make: everything
 /// that reads the frames, which are freed on return.
-fn split_plan(
-    p: &Primitive,
-    uv_set: u32,
-    transform: Option<&UvTransform>,
-    opts: &Options,
-) -> (SplitPlan, FallbackCounts) {
-    let uv_name = format!("TEXCOORD_{uv_set}");
+fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
+    let p = &g.primitive;
+    let uv_name = g.tangent_uvs.attribute();
     let n_vertices = p.vertex_count();
     // Borrowed from the streams where possible. Without POSITION (callers skip such primitives)
     // the surface is a point.
-    let positions = p.attr("POSITION").map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 3]; n_vertices].into());
-    let uvs = p.attr(&uv_name).map(|s| s.as_f32()).unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
-    let uvs = dequant::transformed_uvs(uvs, transform);
+    let positions = g.positions();
+    let uvs = g.tangent_uv_values().unwrap_or_else(|| vec![[0.0; 2]; n_vertices].into());
 
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
-    let generated_normals = p.attr("NORMAL").is_none();
+    let normals = g.normals();
+    let generated_normals = normals.is_none();
     // Declared before the branch so the engine's input can borrow them in one arm only.
     #[allow(clippy::type_complexity)]
     let (corner_ids, cp, cu, flat): (Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[f32; 3]>);
-    let (normals, normal_of, mut frames) = if generated_normals {
-        cp = p.indices.iter().map(|&i| positions[i as usize]).collect();
-        flat = flat_normals(&cp).0;
-        cu = p.indices.iter().map(|&i| uvs[i as usize]).collect();
-        corner_ids = (0..p.indices.len() as u32).collect();
-        let frames = generate_with_stack(
-            &TriMesh { positions: &cp, normals: &flat, uvs: &cu, indices: &corner_ids },
-            opts.engine,
-        );
-        (flat.as_slice().into(), corner_ids.as_slice(), frames)
-    } else {
-        let n = p.attr("NORMAL").map(dequant::unit_normals).unwrap_or_default();
-        let frames = generate_with_stack(
-            &TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices },
-            opts.engine,
-        );
-        (n, p.indices.as_slice(), frames)
+    let (normals, normal_of, mut frames) = match normals {
+        None => {
+            cp = p.indices.iter().map(|&i| positions[i as usize]).collect();
+            flat = flat_normals(&cp).0;
+            cu = p.indices.iter().map(|&i| uvs[i as usize]).collect();
+            corner_ids = (0..p.indices.len() as u32).collect();
+            let frames = generate_with_stack(
+                &TriMesh { positions: &cp, normals: &flat, uvs: &cu, indices: &corner_ids },
+                opts.engine,
+            );
+            (flat.as_slice().into(), corner_ids.as_slice(), frames)
+        }
+        Some(n) => {
+            let frames = generate_with_stack(
+                &TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices },
+                opts.engine,
+            );
+            (n, p.indices.as_slice(), frames)
+        }
     };
     drop((positions, uvs));
     crate::report::mem_mark("engine");
@@ -166,7 +156,7 @@ fn split_plan(
     }
     let morph = if morph::needed(p, &uv_name) {
         let base = morph::Base { tangent: &tangent, normals: &normals, generated_normals };
-        morph::deltas(p, &uv_name, &base, opts.engine)
+        morph::deltas(g, &base, opts.engine)
     } else {
         Vec::new()
     };

@@ -9,7 +9,7 @@
 //! (the file then has no NORMAL delta either).
 
 use super::{fallback, generate_with_stack, mikk, TriMesh};
-use crate::scene::Primitive;
+use crate::scene::{Geometry, Primitive};
 use glam::Vec3;
 
 /// Whether `p`'s targets need TANGENT deltas: one moves what frames are made from (POSITION,
@@ -31,26 +31,23 @@ pub(super) struct Base<'a> {
 }
 
 /// For each target, one TANGENT delta per corner of `p`: the morphed frame minus the base frame.
-pub(super) fn deltas(p: &Primitive, uv_name: &str, base: &Base, engine: mikk::Engine) -> Vec<Vec<[f32; 3]>> {
-    let n = p.vertex_count();
+pub(super) fn deltas(g: &Geometry, base: &Base, engine: mikk::Engine) -> Vec<Vec<[f32; 3]>> {
+    let p = &g.primitive;
+    let uv_name = g.tangent_uvs.attribute();
     let corners = p.indices.len();
     let pos = p.positions();
-    let uv: Vec<[f32; 2]> = p.attr(uv_name).map(|s| s.to_f32()).unwrap_or_else(|| vec![[0.0; 2]; n]);
     let corner_ids: Vec<u32> = if base.generated_normals { (0..corners as u32).collect() } else { Vec::new() };
     p.targets
         .iter()
         .map(|t| {
             let find = |name: &str| t.iter().find(|(k, _)| k == name).map(|(_, s)| s);
             let dp: Option<Vec<[f32; 3]>> = find("POSITION").map(|s| s.to_f32());
-            let duv: Option<Vec<[f32; 2]>> = find(uv_name).map(|s| s.to_f32());
             let mpos: Vec<[f32; 3]> = match &dp {
                 Some(d) => pos.iter().zip(d).map(|(a, b)| [a[0] + b[0], a[1] + b[1], a[2] + b[2]]).collect(),
                 None => pos.clone(),
             };
-            let muv: Vec<[f32; 2]> = match &duv {
-                Some(d) => uv.iter().zip(d).map(|(a, b)| [a[0] + b[0], a[1] + b[1]]).collect(),
-                None => uv.clone(),
-            };
+            // Morphed, then through the texture's transform, as the base frames' UVs were.
+            let muv = g.morphed_tangent_uvs(find(&uv_name));
             // Corner-wise where bumpbake made flat normals (as the base frames were), else by vertex.
             let (positions, uvs, normals, idx): Streams = if base.generated_normals {
                 let cp = p.indices.iter().map(|&i| mpos[i as usize]).collect();

@@ -12,8 +12,8 @@ use crate::error::{Error, Result};
 use crate::format::raw::{read_raw, RawMesh};
 use crate::scene::nodes::{instances, Instance};
 use crate::scene::to_triangle_list;
-use crate::scene::{smooth_vertex_normals, PrimRef, ReadOptions, Scene, Slot};
-use glam::{DVec3, Mat3, Mat4, Vec3, Vec3A};
+use crate::scene::{smooth_vertex_normals, PrimRef, PrimView, ReadOptions, Scene};
+use glam::{DVec3, Mat4, Vec3, Vec3A};
 use std::path::Path;
 
 /// LOW after tangents: per-vertex streams of every baked primitive, appended.
@@ -126,8 +126,7 @@ fn dvec(p: [f32; 3]) -> DVec3 {
 
 pub fn is_triangles(scene: &Scene, r: PrimRef) -> bool {
     let pj = scene.prim_json(r);
-    (4..=6).contains(&pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4))
-        && pj.pointer("/attributes/POSITION").is_some()
+    crate::scene::Mode::of(pj).has_triangles() && pj.pointer("/attributes/POSITION").is_some()
 }
 
 fn node_name(scene: &Scene, n: usize) -> String {
@@ -233,10 +232,14 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
     }
     for (pl, &part) in placed.iter().zip(part) {
         let r = pl.prim;
-        let set = mats.default_of(scene, r).and_then(|m| m.texture(Slot::Normal)).map_or(0, |t| t.tex_coord);
-        let p = scene.primitive(r)?;
+        // The map is laid out in the UVs the renderer samples the normal texture with, the ones
+        // the tangents follow (the view's one rule).
+        let view = PrimView::new(scene, mats, r);
+        let uv_set = view.tangent_uvs();
+        let g = view.read(scene)?;
+        let p = &g.primitive;
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
-        for need in [&format!("TEXCOORD_{set}"), "POSITION", "NORMAL", "TANGENT"] {
+        for need in [&uv_set.attribute(), "POSITION", "NORMAL", "TANGENT"] {
             if p.attr(need).is_none() {
                 return Err(scene.err(format!(
                     "{where_} has no {need}; baking from HIGH needs LOW's UV layout (give LOW UVs, or choose another material with --material)"
@@ -245,26 +248,24 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
         }
         let base = out.positions.len() as u32;
         out.positions.extend(world_positions(scene, pl)?.into_iter().map(|q| local(q, origin)));
-        let normals: Vec<[f32; 3]> = p.attr("NORMAL").map(|s| s.to_f32::<3>()).unwrap_or_default();
-        let tangents: Vec<[f32; 4]> = p.attr("TANGENT").map(|s| s.to_f32::<4>()).unwrap_or_default();
+        let normals = g.normals().unwrap_or_default();
+        let tangents: Vec<[f32; 4]> = g.tangents().unwrap_or_default();
         match pl.world {
             None => {
-                out.normals.extend(normals.into_iter().map(Vec3A::from));
+                out.normals.extend(normals.iter().map(|&n| Vec3A::from(n)));
                 out.tangents.extend(tangents);
             }
             Some(m) => {
-                let m3 = Mat3::from_mat4(m);
-                let nm = m3.inverse().transpose();
-                let sign = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
-                out.normals.extend(normals.into_iter().map(|n| Vec3A::from(nm * Vec3::from(n)).normalize_or_zero()));
+                let inst = Instance { mesh: r.mesh, node: None, world: m };
+                let (m3, nm) = (inst.tangent_matrix(), inst.normal_matrix());
+                out.normals.extend(normals.iter().map(|&n| Vec3A::from(nm * Vec3::from(n)).normalize_or_zero()));
                 out.tangents.extend(tangents.into_iter().map(|t| {
                     let v = (m3 * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
-                    [v.x, v.y, v.z, t[3] * sign]
+                    [v.x, v.y, v.z, inst.world_w(t[3])]
                 }));
             }
         }
-        let uvs: Vec<[f32; 2]> = p.attr(&format!("TEXCOORD_{set}")).map(|s| s.to_f32()).unwrap_or_default();
-        out.uvs.extend(uvs);
+        out.uvs.extend(g.uvs(uv_set).unwrap_or_default().iter());
         out.triangles.extend(p.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
         out.tri_part.resize(out.triangles.len(), part);
     }

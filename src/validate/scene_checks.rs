@@ -4,35 +4,33 @@
 use super::frames::{self, Explained, PrimData, Quant};
 use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
 use crate::error::Result;
-use crate::format::{dequant, image};
-use crate::scene::to_triangle_list;
+use crate::format::image;
+use crate::scene::nodes::instances;
+use crate::scene::view::views;
 use crate::scene::{Materials, PrimRef, Scene};
 use rayon::prelude::*;
 use serde_json::Value;
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     // Reading is cheap and may fail (exit 2); checking is the expensive part and runs in parallel.
     let mut subjects = Vec::new();
     let mats = scene.materials();
-    for r in scene.primitives() {
+    for view in views(scene, mats) {
+        let r = view.at;
         let mut s = Subject::new("primitive", prim_name(scene, r));
         s.mesh = Some(r.mesh);
         s.primitive = Some(r.primitive);
-        let pj = scene.prim_json(r);
-        check_texcoords(scene, &mats, r, &mut s);
-        let mode = pj.get("mode").and_then(|m| m.as_u64()).unwrap_or(4);
+        check_texcoords(scene, mats, r, &mut s);
         // A compressed primitive whose normal map needs frames is a warning: its frames go
         // unchecked, and `--strict` must not pass them silently.
         let (code, why) = if let Some(why) = crate::format::draco::why_unreadable(scene, r) {
-            let code = if mats.tangent_need(scene, r).is_some() {
-                Code::PRIMITIVE_COMPRESSED
-            } else {
-                Code::PRIMITIVE_NOT_CHECKED
-            };
+            let code =
+                if view.tangent_need.is_some() { Code::PRIMITIVE_COMPRESSED } else { Code::PRIMITIVE_NOT_CHECKED };
             (code, Some(why))
-        } else if !(4..=6).contains(&mode) {
-            (Code::PRIMITIVE_NOT_CHECKED, Some(format!("not triangles (mode {mode})")))
+        } else if !view.mode.has_triangles() {
+            (Code::PRIMITIVE_NOT_CHECKED, Some(format!("not triangles (mode {})", view.mode)))
         } else {
             (Code::PRIMITIVE_NOT_CHECKED, None)
         };
@@ -41,7 +39,8 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             subjects.push((s, None));
             continue;
         }
-        let p = to_triangle_list(scene.primitive(r)?);
+        let g = view.read(scene)?;
+        let p = &g.primitive;
         if p.attr("POSITION").map(|s| s.len()) != Some(p.vertex_count()) {
             let f = Finding::new(
                 Code::PRIMITIVE_NOT_CHECKED,
@@ -54,27 +53,22 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             subjects.push((s, None));
             continue;
         }
-        // Compared as a renderer sees them: quantized normals made unit, UVs through the transform
-        // of the texture the tangents serve (the UVs the tangent must follow).
-        let need = mats.tangent_need(scene, r);
-        let uv_name = format!("TEXCOORD_{}", need.as_ref().map_or(0, |n| n.need.tex_coord));
-        let uv_t = need.as_ref().and_then(|n| n.need.transform);
+        // Compared as a renderer sees them (the view's values): quantized normals made unit, UVs
+        // through the transform of the texture the tangents serve (the UVs the tangent must follow).
+        let uvs = view.tangent_uvs();
         let step = |name: &str| p.attr(name).map_or(0.0, |s| s.step() as f64);
         let quant = Quant {
             position: step("POSITION"),
             normal: step("NORMAL"),
-            uv: step(&uv_name) * uv_t.as_ref().map_or(1.0, |t| t.max_stretch()),
+            uv: step(&uvs.attribute()) * uvs.transform.as_ref().map_or(1.0, |t| t.max_stretch()),
             tangent: step("TANGENT"),
         };
-        let d = PrimData {
-            positions: p.positions(),
-            normals: p.attr("NORMAL").map(|s| dequant::unit_normals(s).into_owned()),
-            uvs: p.attr(&uv_name).map(|s| dequant::transformed_uvs(s.as_f32(), uv_t.as_ref()).into_owned()),
-            tangents: p.attr("TANGENT").map(|s| s.to_f32::<4>()),
-            quant,
-            indices: p.indices,
-        };
-        let wanted_by = need.map(|n| n.describe());
+        let positions = g.positions().into_owned();
+        let normals = g.normals().map(Cow::into_owned);
+        let tangent_uvs = g.tangent_uv_values().map(Cow::into_owned);
+        let tangents = g.tangents();
+        let d = PrimData { positions, normals, uvs: tangent_uvs, tangents, quant, indices: g.primitive.indices };
+        let wanted_by = view.tangent_need.map(|n| n.describe());
         subjects.push((s, Some((d, wanted_by))));
     }
     let max_angle = opts.max_angle_deg;
@@ -91,7 +85,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     if let Some(s) = check_nodes(scene) {
         done.push(s);
     }
-    done.extend(check_images(scene, &mats));
+    done.extend(check_images(scene, mats));
     Ok(done)
 }
 
@@ -199,55 +193,32 @@ fn check_primitive(d: &PrimData, wanted_by: Option<&str>, max_angle_deg: f64, st
     conformance::check(d, max_angle_deg, &mut ex, s);
 }
 
-/// Nodes that show a mesh through a mirroring transform (negative determinant along the path
-/// from the root).
+/// Nodes that show a mesh through a mirroring transform (negative determinant of the world
+/// matrix), over the nodes the scene shows ([`instances`], the walk every stage places meshes with).
 fn check_nodes(scene: &Scene) -> Option<Subject> {
-    let nodes = scene.json.get("nodes").and_then(|n| n.as_array())?;
-    let n = nodes.len();
-    let mut parent = vec![usize::MAX; n];
-    for (i, node) in nodes.iter().enumerate() {
-        for c in node.get("children").and_then(|c| c.as_array()).into_iter().flatten() {
-            if let Some(c) = c.as_u64().map(|c| c as usize).filter(|&c| c < n && parent[c] == usize::MAX) {
-                parent[c] = i;
-            }
-        }
-    }
-    let local: Vec<i8> = nodes.iter().map(local_det_sign).collect();
-    // World sign, memoised; a cycle (invalid glTF) is cut at the first repeat.
-    let mut world = vec![0i8; n];
-    for start in 0..n {
-        let mut path = Vec::new();
-        let mut at = start;
-        while at != usize::MAX && world[at] == 0 && path.len() <= n {
-            path.push(at);
-            at = parent[at];
-        }
-        let mut sign = if at != usize::MAX && world[at] != 0 { world[at] } else { 1 };
-        for &k in path.iter().rev() {
-            sign *= local[k];
-            world[k] = sign;
-        }
-    }
-    let with_mesh: Vec<usize> = (0..n).filter(|&i| nodes[i].get("mesh").is_some()).collect();
-    if with_mesh.is_empty() {
+    let mut shown: Vec<(usize, usize, bool)> =
+        instances(scene).iter().filter_map(|i| Some((i.node?, i.mesh, i.mirrored()))).collect();
+    shown.sort_by_key(|s| s.0);
+    shown.dedup_by_key(|s| s.0);
+    if shown.is_empty() {
         return None;
     }
-    let mirrored: Vec<usize> = with_mesh.iter().copied().filter(|&i| world[i] < 0).collect();
+    let name = |i: usize| scene.json.pointer(&format!("/nodes/{i}/name")).and_then(|x| x.as_str());
     let mut s = Subject::new("file", "node transforms");
     let mut worst = Worst::default();
-    for &i in &mirrored {
+    let mirrored: Vec<&(usize, usize, bool)> = shown.iter().filter(|s| s.2).collect();
+    for &&(i, mesh, _) in &mirrored {
         worst.push(1.0 / (1.0 + i as f64), || Example {
             kind: "node",
             index: i as u64,
             at: None,
             detail: format!(
-                "node {i}{} shows mesh {} mirrored",
-                nodes[i].get("name").and_then(|x| x.as_str()).map(|x| format!(" ('{x}')")).unwrap_or_default(),
-                nodes[i]["mesh"]
+                "node {i}{} shows mesh {mesh} mirrored",
+                name(i).map(|x| format!(" ('{x}')")).unwrap_or_default()
             ),
         });
     }
-    let (count, total) = (mirrored.len(), with_mesh.len());
+    let (count, total) = (mirrored.len(), shown.len());
     s.check(
         Code::NODE_MIRRORED,
         (count > 0).then(|| {
@@ -262,24 +233,6 @@ fn check_nodes(scene: &Scene) -> Option<Subject> {
         }),
     );
     Some(s)
-}
-
-fn local_det_sign(node: &Value) -> i8 {
-    let num = |v: &Value| v.as_f64().unwrap_or(0.0);
-    let det = if let Some(m) = node.get("matrix").and_then(|m| m.as_array()).filter(|m| m.len() == 16) {
-        let e = |c: usize, r: usize| num(&m[c * 4 + r]);
-        e(0, 0) * (e(1, 1) * e(2, 2) - e(2, 1) * e(1, 2)) - e(1, 0) * (e(0, 1) * e(2, 2) - e(2, 1) * e(0, 2))
-            + e(2, 0) * (e(0, 1) * e(1, 2) - e(1, 1) * e(0, 2))
-    } else if let Some(sc) = node.get("scale").and_then(|s| s.as_array()).filter(|s| s.len() == 3) {
-        num(&sc[0]) * num(&sc[1]) * num(&sc[2])
-    } else {
-        1.0
-    };
-    if det < 0.0 {
-        -1
-    } else {
-        1
-    }
 }
 
 /// Each image some material's normal (or clearcoat normal) texture can show, its core source and
