@@ -99,7 +99,7 @@ fn strength(args: &Args) -> Result<f32> {
 pub struct Converted {
     pub input: PathBuf,
     pub output: PathBuf,
-    pub timings_ms: bumpbake::report::Timings,
+    pub timings_ms: bumpbake::timings::Timings,
     /// A map that came out (nearly) flat.
     pub warnings: Vec<String>,
     /// Whether this is one of several inputs (the text then names the files).

@@ -1,7 +1,7 @@
 //! What a `bake --from` run did: for the whole run, per material (one map each) and per LOW
 //! part, with the parts paired by name and those left unmatched.
 
-use crate::report::Timings;
+use crate::timings::Timings;
 use std::path::PathBuf;
 
 /// Counts of what happened, per texel unless named otherwise.
