@@ -1,6 +1,6 @@
 //! The `tangents` job as a library call: read, generate, write, report.
 
-use super::apply::{apply, ApplyOptions, PrimReport};
+use super::apply::{apply, ApplyOptions, PrimTangents};
 use crate::error::Result;
 use crate::format::{self, WriteOptions, WriteStats};
 use crate::scene::{ReadOptions, Scene};
@@ -23,7 +23,7 @@ pub struct TangentsJob {
 pub struct TangentsReport {
     pub input: PathBuf,
     pub output: PathBuf,
-    pub primitives: Vec<PrimReport>,
+    pub primitives: Vec<PrimTangents>,
     pub generated: usize,
     pub kept: usize,
     pub skipped: usize,
@@ -65,7 +65,7 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
 fn summarise(
     input: &Path,
     output: &Path,
-    prims: Vec<PrimReport>,
+    prims: Vec<PrimTangents>,
     notes: Vec<String>,
     written: WriteStats,
     t: Timings,

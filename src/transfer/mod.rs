@@ -29,7 +29,7 @@ pub use parts::Match;
 use raster::{Edges, UvTri};
 use rayon::prelude::*;
 pub use report::{Counts, TransferReport};
-use report::{HighFile, HighPartReport, MaterialReport, Pair, PartStats};
+use report::{HighFile, HighPartReport, MaterialBake, Pair, PartStats};
 use std::path::PathBuf;
 
 /// Default ray reach on each side of LOW, as a fraction of LOW's bounding-box diagonal.
@@ -242,7 +242,7 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
             st.triangles = low.tri_part.iter().filter(|&&p| p as usize == i).count();
         }
         let names = scene.materials();
-        mats.push(MaterialReport {
+        mats.push(MaterialBake {
             material: m,
             name: names.get(m).and_then(|x| x.name.clone()),
             files: extra.iter().map(|(p, _)| p.clone()).collect(),
