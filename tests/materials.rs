@@ -312,26 +312,7 @@ fn preview_frames_follow_the_uvs_tangents_store() {
 fn only_scene_reads_material_textures() {
     let lookups =
         ["Texture\"", "Texture/", "\"texCoord\"", "/texCoord", "KHR_texture_transform/", "/textures/", "material_of("];
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut bad = Vec::new();
-    let mut stack = vec![root.clone()];
-    while let Some(dir) = stack.pop() {
-        for e in std::fs::read_dir(&dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                if p != root.join("scene") && p != root.join("format") {
-                    stack.push(p);
-                }
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                let text = std::fs::read_to_string(&p).unwrap();
-                for (n, line) in text.lines().enumerate() {
-                    if lookups.iter().any(|l| line.contains(l)) {
-                        bad.push(format!("{}:{}: {}", p.display(), n + 1, line.trim()));
-                    }
-                }
-            }
-        }
-    }
+    let bad = stage_lines_containing(&lookups);
     assert!(bad.is_empty(), "material JSON read outside src/scene/ (use Scene::materials):\n{}", bad.join("\n"));
 }
 
