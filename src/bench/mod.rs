@@ -2,6 +2,7 @@
 //! tests and the binary share it.
 
 pub mod batch;
+pub mod blender;
 pub mod command;
 pub mod normalmap;
 pub mod plot;
@@ -10,6 +11,12 @@ pub mod tangents;
 pub mod tangents_plot;
 pub mod transfer;
 pub mod transfer_large;
+
+/// FNV-1a 64 of `bytes` as hex: tells two runs' outputs apart in a report (not a checksum).
+pub(crate) fn fingerprint(bytes: &[u8]) -> String {
+    let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+    format!("{h:016x}")
+}
 
 /// The median of `v` (sorted in place), the mean of the middle two for an even count; 0 when empty.
 pub(crate) fn median(v: &mut [f64]) -> f64 {

@@ -384,6 +384,11 @@ pub struct Row {
     /// What the baker's HIGH (tree, positions, triangles, normals) takes, per triangle.
     pub high_bytes_per_triangle: f64,
     pub error: Evaluation,
+    /// FNV-1a 64 of the last run's OUT: equal for equal maps (OUT names no input file).
+    pub out_fingerprint: String,
+    /// Blender's bake of the same files, interleaved (`--blender`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blender: Option<super::blender::BlenderRow>,
 }
 
 #[derive(Debug, Clone, serde::Serialize)]
@@ -411,11 +416,18 @@ pub(crate) fn time_one(
     samples: usize,
     runs: usize,
     torus: &Torus,
+    blender: Option<&super::blender::Blender>,
 ) -> Result<Row> {
     let out = dir.join(format!("out_{tris}_{size}_{samples}.glb"));
+    let reach = 0.05 * 2.0 * (torus.major + torus.minor);
     let (mut times, mut stages, mut peak) = (Vec::new(), [Vec::new(), Vec::new(), Vec::new()], 0u64);
     let mut high_bytes = 0.0;
+    let mut theirs = super::blender::Runs::default();
     for _ in 0..runs.max(1) {
+        // Interleaved with bumpbake's runs, so both see the same machine.
+        if let Some(b) = blender {
+            b.run(dir, low, high, size, reach, &mut theirs)?;
+        }
         let t = std::time::Instant::now();
         let o = std::process::Command::new(exe)
             .arg("bake")
@@ -442,18 +454,19 @@ pub(crate) fn time_one(
             stages[k].push(ms);
         }
     }
-    let reach = 0.05 * 2.0 * (torus.major + torus.minor);
     let error = evaluate(&out, &|p, d| torus.truth(p, d, reach), &|_| true)?;
+    let out_fingerprint = std::fs::read(&out).map(|b| super::fingerprint(&b)).unwrap_or_default();
     let _ = std::fs::remove_file(&out);
     let (min_s, max_s) =
         (times.iter().cloned().fold(f64::INFINITY, f64::min), times.iter().cloned().fold(0.0, f64::max));
     let [mut a, mut b, mut c] = stages;
+    let median_s = super::median(&mut times);
     Ok(Row {
         high_triangles: tris,
         size,
         samples,
         runs: times.len(),
-        median_s: super::median(&mut times),
+        median_s,
         min_s,
         max_s,
         read_high_ms: super::median(&mut a),
@@ -462,6 +475,8 @@ pub(crate) fn time_one(
         peak_mb: peak as f64 * 1024.0 / 1e6,
         high_bytes_per_triangle: high_bytes / tris as f64,
         error,
+        out_fingerprint,
+        blender: blender.map(|_| theirs.row(median_s)),
     })
 }
 
@@ -503,12 +518,12 @@ pub fn run(
         let tris = 2 * a * b;
         if k == 2 {
             for &(size, samples) in quality {
-                let r = time_one(exe, dir, &low, &high, tris, size, samples, runs, &torus)?;
+                let r = time_one(exe, dir, &low, &high, tris, size, samples, runs, &torus, None)?;
                 progress(&r);
                 rows.push(r);
             }
         }
-        let r = time_one(exe, dir, &low, &high, tris, 1024, 1, runs, &torus)?;
+        let r = time_one(exe, dir, &low, &high, tris, 1024, 1, runs, &torus, None)?;
         progress(&r);
         scaling.push(r);
         let _ = std::fs::remove_file(&high);

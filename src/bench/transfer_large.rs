@@ -51,6 +51,13 @@ pub struct LargeRow {
     /// What the baker's HIGH (tree, positions, triangles, normals) takes alone, per triangle.
     pub high_bytes_per_triangle: f64,
     pub error: Evaluation,
+    /// FNV-1a 64 of OUT: the same HIGH from memory, OBJ and PLY bakes the same bytes.
+    pub out_fingerprint: String,
+    /// Runs of a file row (a memory row runs once); `wall_s` and the stages are medians.
+    pub runs: usize,
+    /// Blender's bake of the same files, interleaved (`--blender`, file rows only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blender: Option<super::blender::BlenderRow>,
 }
 
 /// The tessellation with about `millions` million triangles, the ring twice the tube's count.
@@ -191,8 +198,9 @@ pub fn large_row(
     low: &Path,
     (n_th, n_ph): (usize, usize),
     source: Source,
-    size: usize,
+    plan: &Plan,
 ) -> Result<LargeRow> {
+    let size = plan.size;
     let torus = Torus::default();
     let tris = 2 * n_th * n_ph;
     let mesh = torus.high_raw(n_th, n_ph);
@@ -211,6 +219,9 @@ pub fn large_row(
         bytes_per_triangle: peak as f64 / tris as f64,
         high_bytes_per_triangle: high_bytes / tris as f64,
         error,
+        out_fingerprint: String::new(),
+        runs: 1,
+        blender: None,
     };
     if source == Source::Memory {
         let out = dir.join(format!("out_mem_{tris}.glb"));
@@ -218,9 +229,11 @@ pub fn large_row(
         let tr = r.transfer.ok_or_else(|| Error::usage("bench transfer: the bake made no transfer report"))?;
         let stage = |n: &str| tr.timings_ms.stages.iter().find(|s| s.0 == n).map_or(f64::NAN, |s| s.1);
         let error = evaluate(&out, &truth, &|_| true)?;
+        let fingerprint = std::fs::read(&out).map(|b| super::fingerprint(&b)).unwrap_or_default();
         let _ = std::fs::remove_file(&out);
         let stages = [stage("read high"), stage("bvh"), stage("rays")];
-        return Ok(row(0.0, wall, stages, peak, tr.high_bytes as f64, error));
+        let row = row(0.0, wall, stages, peak, tr.high_bytes as f64, error);
+        return Ok(LargeRow { out_fingerprint: fingerprint, ..row });
     }
     let path = dir.join(format!("high_{tris}.{}", if source == Source::Obj { "obj" } else { "ply" }));
     match source {
@@ -229,22 +242,23 @@ pub fn large_row(
     }
     drop(mesh);
     let file_mb = std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6);
-    let r = time_one(exe, dir, low, &path, tris, size, 1, 1, &torus);
+    let r = time_one(exe, dir, low, &path, tris, size, 1, plan.runs, &torus, plan.blender.as_ref());
     let _ = std::fs::remove_file(&path);
     let r = r?;
     let stages = [r.read_high_ms, r.bvh_ms, r.rays_ms];
     let high_bytes = r.high_bytes_per_triangle * tris as f64;
-    Ok(row(file_mb, r.median_s, stages, (r.peak_mb * 1e6) as u64, high_bytes, r.error))
+    let row = row(file_mb, r.median_s, stages, (r.peak_mb * 1e6) as u64, high_bytes, r.error);
+    Ok(LargeRow { runs: r.runs, blender: r.blender, out_fingerprint: r.out_fingerprint, ..row })
 }
 
 /// The large rows as a text table.
 pub fn table(rows: &[LargeRow]) -> String {
     let mut s = String::from(
-        "HIGH tris  from     file MB  size  wall s  read ms  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°\n",
+        "HIGH tris  from     file MB  size  wall s  read ms  bvh ms  rays ms  peak MB  B/tri  (HIGH alone)  mean°  p99°  OUT\n",
     );
     for r in rows {
         s += &format!(
-            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>8.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}\n",
+            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>8.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}  {}\n",
             r.high_triangles,
             format!("{:?}", r.source).to_lowercase(),
             r.file_mb,
@@ -257,8 +271,28 @@ pub fn table(rows: &[LargeRow]) -> String {
             r.bytes_per_triangle,
             r.high_bytes_per_triangle,
             r.error.synced.mean,
-            r.error.synced.p99
+            r.error.synced.p99,
+            &r.out_fingerprint[..r.out_fingerprint.len().min(8)]
         );
+    }
+    for r in rows {
+        if let Some(b) = &r.blender {
+            s += &format!(
+                "Blender {} on the same {} ({} triangles), {} runs: median {:.2} s ({:.2}-{:.2}; import {:.2} s, bake {:.2} s), peak {:.0} MB: bumpbake {:.1}x faster, {:.1}x less memory\n",
+                b.version,
+                format!("{:?}", r.source).to_uppercase(),
+                r.high_triangles,
+                b.runs,
+                b.median_s,
+                b.min_s,
+                b.max_s,
+                b.import_high_s,
+                b.bake_s,
+                b.peak_mb,
+                b.ratio,
+                b.peak_mb / r.peak_mb
+            );
+        }
     }
     s
 }
@@ -270,6 +304,10 @@ pub struct Plan {
     pub millions: Vec<f64>,
     pub sources: Vec<Source>,
     pub size: usize,
+    /// Runs of each file row (medians reported).
+    pub runs: usize,
+    /// Blender's bake of each file row's files, interleaved with bumpbake's runs.
+    pub blender: Option<super::blender::Blender>,
 }
 
 /// Every row of `plan`, with the bench's LOW written into `dir`.
@@ -283,7 +321,7 @@ pub fn run(exe: &Path, dir: &Path, plan: &Plan, mut progress: impl FnMut(&LargeR
     std::fs::write(&low, Torus::default().low(48, 24).glb()).map_err(|e| Error::output(&low, e))?;
     for &m in &plan.millions {
         for &source in &plan.sources {
-            let r = large_row(exe, dir, &low, tessellation(m), source, plan.size)?;
+            let r = large_row(exe, dir, &low, tessellation(m), source, plan)?;
             progress(&r);
             rows.push(r);
         }

@@ -7,7 +7,8 @@ use bumpbake::{Error, Result};
 #[command(after_help = "Examples:
   bumpbake bench transfer
   bumpbake bench transfer --runs 7 --json > transfer-bench.json
-  bumpbake bench transfer --runs 0 --large 10 --large-from memory,obj")]
+  bumpbake bench transfer --runs 0 --large 10 --large-from memory,obj
+  bumpbake bench transfer --runs 0 --large 10.24 --large-from obj --large-runs 3 --blender python3")]
 pub struct BenchTransferArgs {
     /// Timed runs of each configuration (each a new process); medians are reported. 0 skips the
     /// 600k-and-below rows.
@@ -27,6 +28,13 @@ pub struct BenchTransferArgs {
     /// Map size of the large rows.
     #[arg(long, default_value_t = 2048)]
     pub large_size: usize,
+    /// Runs of each large row read from a file (medians reported); memory rows run once.
+    #[arg(long, default_value_t = 1)]
+    pub large_runs: usize,
+    /// A Python that imports `bpy` (Blender as a module): Blender bakes each large file row's
+    /// files too, interleaved with bumpbake's runs, and the row gives the ratio.
+    #[arg(long, value_name = "PYTHON")]
+    pub blender: Option<std::path::PathBuf>,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -63,7 +71,8 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
     if !(1..=8192).contains(&a.large_size) {
         return Err(Error::usage("--large-size: 1 to 8192 texels"));
     }
-    let plan = Plan { millions, sources, size: a.large_size };
+    let blender = a.blender.clone().map(|python| bumpbake::bench::blender::Blender { python });
+    let plan = Plan { millions, sources, size: a.large_size, runs: a.large_runs.max(1), blender };
     let quiet = a.json;
     let r = super::shared::with_scratch("transfer", |exe, dir| {
         let mut r = if a.runs == 0 {
