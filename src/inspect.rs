@@ -88,7 +88,7 @@ pub struct ImageInfo {
 pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let scene = Scene::read(path, opts)?;
     let arr = |k: &str| scene.json.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
-    let mats = scene.materials();
+    let mats = scene.materials().clone();
     let mut primitives = Vec::new();
     for view in views(&scene, &mats) {
         let r = view.at;
@@ -100,8 +100,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
             mesh: r.mesh,
             primitive: r.primitive,
             mode: mode.0,
-            // As the file declares it, even when it names no material.
-            material: scene.prim_json(r).get("material").and_then(|m| m.as_u64()).map(|m| m as usize),
+            material: scene.material_index(r),
             vertices: p.vertex_count(),
             triangles: if mode == Mode::TRIANGLES { p.indices.len() / 3 } else { p.indices.len().saturating_sub(2) },
             attributes: p
@@ -200,90 +199,4 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
         Err(e) => info.error = Some(e.to_string()),
     }
     info
-}
-
-impl Inspection {
-    pub fn text(&self) -> String {
-        let mut s = format!(
-            "{} ({}): {} nodes, {} meshes, {} animations, {} skins\n",
-            self.file.display(),
-            self.format,
-            self.nodes,
-            self.meshes,
-            self.animations,
-            self.skins
-        );
-        if !self.extensions_used.is_empty() {
-            s += &format!("  extensions: {}\n", self.extensions_used.join(", "));
-        }
-        for p in &self.primitives {
-            let attrs: Vec<String> = p.attributes.iter().map(|a| format!("{} {}", a.name, a.r#type)).collect();
-            s += &format!(
-                "  mesh {} primitive {}: {} vertices, {} triangles, material {}\n    attributes: {}\n",
-                p.mesh,
-                p.primitive,
-                p.vertices,
-                p.triangles,
-                p.material.map(|m| m.to_string()).unwrap_or("-".into()),
-                attrs.join(", ")
-            );
-            let by = |uv: &str| p.tangents_needed_by.clone().unwrap_or_else(|| format!("--all reads {uv}"));
-            let t = match (&p.tangents_needed_from, p.has_tangents) {
-                (Some(uv), true) => format!("present; needed ({})", by(uv)),
-                (Some(uv), false) => format!("MISSING; needed ({})", by(uv)),
-                (None, true) => format!("present but unused ({})", p.tangents_not_needed.as_deref().unwrap_or("")),
-                (None, false) => format!("none; not needed ({})", p.tangents_not_needed.as_deref().unwrap_or("")),
-            };
-            s += &format!("    tangents: {t}\n");
-            for c in &p.tangent_conflicts {
-                s += &format!("    note: {c}\n");
-            }
-        }
-        for m in &self.materials {
-            s += &format!("  material {} {}: ", m.index, m.name.as_deref().unwrap_or(""));
-            let mut parts = Vec::new();
-            if let Some(i) = m.base_color_image {
-                parts.push(format!("base colour image {i}"));
-            }
-            if let Some(i) = m.normal_image {
-                parts.push(format!(
-                    "normal image {i} (TEXCOORD_{}, scale {})",
-                    m.normal_tex_coord.unwrap_or(0),
-                    m.normal_scale.unwrap_or(1.0)
-                ));
-            }
-            if let Some(h) = &m.height_map {
-                parts.push(format!("height map {}", h.display()));
-            }
-            for t in m.textures.iter().filter(|t| !matches!(t.slot, Slot::BaseColor | Slot::Normal)) {
-                let img = t.image().map(|i| format!("image {i}")).unwrap_or_else(|| "no image".into());
-                parts.push(format!("{:?} {img} (TEXCOORD_{})", t.slot, t.tex_coord));
-            }
-            if !m.tangents_needed_by.is_empty() {
-                parts.push(format!("needs tangents: {}", m.tangents_needed_by.join(", ")));
-            }
-            s += &(if parts.is_empty() { "no textures".to_string() } else { parts.join(", ") } + "\n");
-        }
-        for i in &self.images {
-            match (&i.error, i.width) {
-                (None, Some(w)) => {
-                    s += &format!(
-                        "  image {}: {}x{} {}{} {}-bit {} ({} bytes, {})\n",
-                        i.index,
-                        w,
-                        i.height.unwrap_or(0),
-                        i.format.as_deref().unwrap_or("?"),
-                        i.variant.as_ref().map(|v| format!(" ({v})")).unwrap_or_default(),
-                        i.bits_per_channel.unwrap_or(0),
-                        i.color.as_deref().unwrap_or(""),
-                        i.bytes,
-                        i.stored
-                    )
-                }
-                (Some(e), _) => s += &format!("  image {}: unreadable: {e}\n", i.index),
-                _ => s += &format!("  image {}: {} bytes\n", i.index, i.bytes),
-            }
-        }
-        s
-    }
 }

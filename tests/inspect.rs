@@ -46,3 +46,50 @@ fn inspect_sees_a_16_bit_image_and_an_obj_height_map() {
     assert_eq!(v["images"][0]["width"], 3);
     assert!(v["materials"][0]["height_map"].as_str().unwrap().ends_with("h.png"));
 }
+
+/// A bad file among good ones is reported in its place (a record or a line of its own) and the
+/// files after it are still inspected; the run exits with the worst code (2), as validate does.
+#[test]
+fn inspect_reports_every_file_when_one_is_bad() {
+    let d = scratch_dir("inspect_bad_among_good");
+    let good = fixture("khronos/NormalTangentTest.glb");
+    std::fs::write(d.join("bad.glb"), b"glTF\x02\0\0\0").unwrap();
+    std::fs::write(d.join("bad.obj"), "v 0 0 0\nf 1 2 3\n").unwrap();
+    let bad = d.join("bad.glb");
+    let o = run(&["inspect", "--json", s(&good), s(&bad), s(&good), s(&d.join("bad.obj"))]);
+    assert_eq!(o.status.code(), Some(2), "the worst code: an unusable file");
+    let recs: Vec<serde_json::Value> =
+        String::from_utf8(o.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(recs.len(), 4, "one record per file, in input order");
+    assert!(recs.iter().all(|r| r["schema"] == "bumpbake-inspect/1"));
+    for i in [0, 2] {
+        assert_eq!(recs[i]["file"], s(&good));
+        assert_eq!(recs[i]["primitives"][0]["vertices"], 3983);
+        assert!(recs[i].get("status").is_none(), "ok records stay as the schema first wrote them");
+    }
+    for (i, name) in [(1, "bad.glb"), (3, "bad.obj")] {
+        assert_eq!(recs[i]["status"], "error");
+        assert_eq!(recs[i]["exit_code"], 2);
+        assert!(recs[i]["file"].as_str().unwrap().ends_with(name));
+        let e = recs[i]["error"].as_str().unwrap();
+        assert!(e.contains(name) && !e.contains('\n'), "one line naming the file: {e}");
+    }
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("4 files: 2 inspected, 2 failed"), "{err}");
+
+    // As text: both good files on stdout, each bad one a line on stderr.
+    let o = run(&["inspect", s(&good), s(&bad), s(&good)]);
+    assert_eq!(o.status.code(), Some(2));
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(out.matches("tangents: MISSING; needed (normal texture reads TEXCOORD_0)").count(), 2, "{out}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 2, "{err}");
+    assert!(lines[0].starts_with("bumpbake: ") && lines[0].contains("bad.glb"), "{err}");
+    assert_eq!(lines[1], format!("3 files: 2 inspected, 1 failed ({})", bad.display()));
+
+    // Alone, a bad file is the command's error, as before.
+    let o = run(&["inspect", s(&bad)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+}

@@ -307,13 +307,81 @@ fn preview_frames_follow_the_uvs_tangents_store() {
 
 // ---------- one reading ----------
 
-/// No stage outside `src/scene/` (the model) and `src/format/` (the readers that build it) reads material textures from the JSON: they ask `MaterialInfo`.
+/// The keys of material JSON: the list, a primitive's reference into it, and what a material
+/// holds (any `...Texture` object and any `KHR_materials_*` extension included).
+fn is_material_key(k: &str) -> bool {
+    const KEYS: &[&str] = &[
+        "materials",
+        "material",
+        "texCoord",
+        "KHR_texture_transform",
+        "pbrMetallicRoughness",
+        "baseColorFactor",
+        "metallicFactor",
+        "roughnessFactor",
+        "emissiveFactor",
+        "alphaMode",
+        "alphaCutoff",
+        "doubleSided",
+    ];
+    KEYS.contains(&k) || k.ends_with("Texture") || k.starts_with("KHR_materials_")
+}
+
+/// The JSON keys a line of code names: words quoted (`get("materials")`, `["texCoord"]`,
+/// `"doubleSided":`) or segments of a JSON pointer (`"/materials/{m}/name"`).
+fn json_keys(line: &str) -> Vec<&str> {
+    let b = line.as_bytes();
+    let word = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        if matches!(b[i], b'"' | b'/') {
+            let mut j = i + 1;
+            while j < b.len() && word(b[j]) {
+                j += 1;
+            }
+            if j > i + 1 && j < b.len() && matches!(b[j], b'"' | b'/') {
+                out.push(&line[i + 1..j]);
+            }
+            i = j.max(i + 1);
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Material JSON is read and changed only in the scene model (`src/scene/`: `Scene::materials`,
+/// `Scene::leave_out` and the methods beside them) and by the readers and writers that build or
+/// store it (`src/format/`). Every other file asks `MaterialInfo`, so no stage decides again what a
+/// material reads.
 #[test]
-fn only_scene_reads_material_textures() {
-    let lookups =
-        ["Texture\"", "Texture/", "\"texCoord\"", "/texCoord", "KHR_texture_transform/", "/textures/", "material_of("];
-    let bad = stage_lines_containing(&lookups);
-    assert!(bad.is_empty(), "material JSON read outside src/scene/ (use Scene::materials):\n{}", bad.join("\n"));
+fn only_the_scene_model_reads_material_json() {
+    let bad = stage_lines_where(|line| {
+        // A texture's JSON and the raw material JSON of a primitive, too.
+        let other = ["/textures/", "material_of("].iter().any(|l| line.contains(l));
+        other || json_keys(line).into_iter().any(is_material_key)
+    });
+    assert!(bad.is_empty(), "material JSON read outside src/scene/ (ask Scene::materials):\n{}", bad.join("\n"));
+}
+
+#[test]
+fn the_material_key_finder_sees_quoted_keys_and_pointer_segments() {
+    fn keys(l: &str) -> Vec<&str> {
+        json_keys(l).into_iter().filter(|k| is_material_key(k)).collect()
+    }
+    assert_eq!(keys(r#"let m = json.get("materials");"#), ["materials"]);
+    assert_eq!(
+        keys(r#"j.pointer(&format!("/materials/{m}/normalTexture/texCoord"))"#),
+        ["materials", "normalTexture", "texCoord"]
+    );
+    assert_eq!(
+        keys(r#"pj["material"] = json!({ "doubleSided": true, "KHR_materials_sheen": {} });"#),
+        ["material", "doubleSided", "KHR_materials_sheen"]
+    );
+    // Words in prose and other keys are not material JSON.
+    assert!(keys(r#"format!("the texture's texCoord (set {n}) and the material's normalTexture")"#).is_empty());
+    assert!(keys(r#"a.get("attributes"); "/meshes/0/primitives""#).is_empty());
 }
 
 /// `KHR_animation_pointer` names materials by index inside JSON pointers, which the reference

@@ -33,8 +33,7 @@ impl Default for HeightSettings {
 /// The wrap mode a material's textures sample with: the sampler of its normal texture, else of
 /// its base colour texture, else glTF's default (repeat). A map's filter must wrap the same way.
 pub fn material_wrap(scene: &Scene, material: usize) -> Wrap {
-    let mats = scene.materials();
-    let m = mats.get(material);
+    let m = scene.materials().get(material);
     let tex = m.and_then(|m| m.texture(Slot::Normal).or_else(|| m.texture(Slot::BaseColor)));
     match scene.sampler_wrap_s(tex.and_then(|t| t.sampler)) {
         33071 => Wrap::Clamp,
@@ -138,9 +137,9 @@ fn encode(img: image::DynamicImage) -> std::result::Result<Vec<u8>, String> {
 /// Gives material `m` the normal map in `png` (PNG or JPEG bytes, as a new image and texture)
 /// from UV set 0, sampled like its base colour texture.
 pub fn attach(scene: &mut Scene, m: usize, png: &[u8], name: &str) {
+    let sampler = scene.materials().get(m).and_then(|m| m.texture(Slot::BaseColor)).and_then(|t| t.sampler);
     let jpeg = crate::format::image::Kind::sniff(png) == crate::format::image::Kind::Jpeg;
     let img = scene.push_image(png, if jpeg { "image/jpeg" } else { "image/png" }, Some(name));
-    let sampler = scene.materials().get(m).and_then(|m| m.texture(Slot::BaseColor)).and_then(|t| t.sampler);
     let t = scene.push_texture(img, sampler);
     scene.set_normal_texture(m, t);
 }
@@ -153,11 +152,8 @@ pub fn flat_png() -> Vec<u8> {
 
 /// Puts `png` in place of the image material `m`'s normal texture shows (its name kept).
 pub fn replace_normal_image(scene: &mut Scene, m: usize, png: &[u8]) {
-    let mats = scene.materials();
-    let Some(img) = mats.get(m).and_then(|m| m.texture(Slot::Normal)).and_then(|t| t.image()) else { return };
-    let name = scene.json["images"][img].get("name").and_then(|n| n.as_str()).map(String::from);
-    let new = scene.push_image(png, "image/png", name.as_deref());
-    let images = crate::scene::array_mut(&mut scene.json, "images");
-    images.swap(img, new);
-    images.pop();
+    let normal = scene.materials().get(m).and_then(|m| m.texture(Slot::Normal));
+    if let Some(img) = normal.and_then(|t| t.image()) {
+        scene.replace_image(img, png);
+    }
 }

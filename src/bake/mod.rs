@@ -1,19 +1,17 @@
 //! `bake`: a mesh and a height or normal map to a render-ready glTF in one step. The map is made
 //! (or converted) and attached, tangents are generated where a normal texture now needs them, and
-//! whatever the scene does not need is left out ([`leave_out`]).
+//! whatever the scene does not need is left out ([`Scene::leave_out`]).
 
-pub mod leave_out;
 pub mod maps;
 
 use crate::error::{Error, Result};
 use crate::format::{self, WriteOptions, WriteStats};
 use crate::normalmap::Convention;
 use crate::report::Timings;
+use crate::scene::leave_out::Removal;
 use crate::scene::{ReadOptions, Scene};
 use crate::tangent::apply::{apply, ApplyOptions, PrimReport};
-use leave_out::Removal;
 use maps::{ConventionCheck, HeightSettings};
-use serde_json::json;
 use std::path::PathBuf;
 
 /// Where the normal map comes from.
@@ -77,7 +75,7 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
     let mut t = Timings::default();
     let mut scene = t.time("read", || Scene::read(&job.mesh, &job.read))?;
     let mut deps = scene.dependencies();
-    ensure_material(&mut scene);
+    scene.ensure_material();
     let mut warnings = Vec::new();
     let targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps, &mut warnings))?;
     check_uv_sets(&scene, job)?;
@@ -100,11 +98,7 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
         }
         _ => None,
     };
-    let removed = if job.keep_all {
-        Vec::new()
-    } else {
-        t.time("leave-out", || leave_out::leave_out(&mut scene, job.bitangents))?
-    };
+    let removed = if job.keep_all { Vec::new() } else { t.time("leave-out", || scene.leave_out(job.bitangents))? };
     let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &deps));
@@ -160,23 +154,8 @@ fn check_uv_sets(scene: &Scene, job: &BakeJob) -> Result<()> {
     Ok(())
 }
 
-/// A scene without materials gets one, so that a map has somewhere to go.
-fn ensure_material(scene: &mut Scene) {
-    if scene.json.get("materials").and_then(|m| m.as_array()).map(|m| !m.is_empty()).unwrap_or(false) {
-        return;
-    }
-    let rs = scene.primitives();
-    scene.json["materials"] = json!([{ "name": "bumpbake", "pbrMetallicRoughness": { "metallicFactor": 0.0 } }]);
-    for r in rs {
-        let pj = &mut scene.json["meshes"][r.mesh]["primitives"][r.primitive];
-        if pj.get("material").is_none() {
-            pj["material"] = json!(0);
-        }
-    }
-}
-
 fn material_names(scene: &Scene) -> Vec<Option<String>> {
-    scene.materials().list.into_iter().map(|m| m.name).collect()
+    scene.materials().list.iter().map(|m| m.name.clone()).collect()
 }
 
 /// Decides which materials get which map, and attaches them.
@@ -194,9 +173,10 @@ fn attach_maps(
         })?),
         None => None,
     };
-    let mats = scene.materials();
-    let has_normal_texture = |m: usize| mats.get(m).and_then(|i| i.texture(crate::scene::Slot::Normal)).is_some();
-    let wants_bump = |m: usize| scene.height_maps.iter().any(|h| h.material == m) || has_normal_texture(m);
+    // As read, before any map is attached below.
+    let has_normal_texture: Vec<bool> =
+        scene.materials().list.iter().map(|i| i.texture(crate::scene::Slot::Normal).is_some()).collect();
+    let wants_bump = |m: usize| scene.height_maps.iter().any(|h| h.material == m) || has_normal_texture[m];
     let targets: Vec<usize> = match (chosen, &job.map) {
         (Some(m), _) => vec![m],
         (None, MapSource::Scene) => (0..names.len()).collect(),
@@ -259,7 +239,7 @@ fn attach_maps(
                         file: Some(h.path.clone()),
                         convention: None,
                     });
-                } else if has_normal_texture(m) {
+                } else if has_normal_texture[m] {
                     out.push(MaterialMap { material: m, name, source: "existing", file: None, convention: None });
                 }
             }
@@ -296,44 +276,4 @@ fn transfer_targets(scene: &mut Scene, job: &BakeJob) -> Result<Vec<usize>> {
         ));
     }
     Ok(out)
-}
-
-impl BakeReport {
-    pub fn text(&self) -> String {
-        let mut s = format!("{} -> {}\n", self.input.display(), self.output.display());
-        for m in &self.maps {
-            let from = m.file.as_ref().map(|f| format!(" from {}", f.display())).unwrap_or_default();
-            s += &format!("  material {} {}: {} map{from}", m.material, m.name.as_deref().unwrap_or(""), m.source);
-            if let Some(c) = &m.convention {
-                s += &format!(
-                    " (looks {} at {:.2}{})",
-                    c.detected,
-                    c.confidence,
-                    if c.converted { ", converted to OpenGL +Y" } else { "" }
-                );
-            }
-            s += "\n";
-        }
-        let gen = self.primitives.iter().filter(|p| p.action == "generated").count();
-        let fb: usize = self.primitives.iter().filter_map(|p| p.stats.as_ref()).map(|s| s.fallback.total()).sum();
-        s += &format!("  tangents: {gen} primitives, {fb} fallback frames\n");
-        for r in &self.removed {
-            s += &format!("  left out {} ({} bytes)\n", r.what, r.bytes);
-        }
-        if !self.removed.is_empty() {
-            s += &format!("  left out {} bytes in all\n", self.removed_bytes);
-        }
-        for n in &self.notes {
-            s += &format!("  note: {n}\n");
-        }
-        for w in &self.warnings {
-            s += &format!("  warning: {w}\n");
-        }
-        if let Some(tr) = &self.transfer {
-            s += &tr.text();
-        }
-        let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
-        s += &format!("  time: {}\n", times.join(", "));
-        s
-    }
 }

@@ -194,9 +194,7 @@ impl Mesh {
             "scene": 0, "scenes": [{ "nodes": [0] }], "nodes": [{ "mesh": 0 }],
         });
         if !self.uvs.is_empty() {
-            prim["material"] = serde_json::json!(0);
-            json["materials"] =
-                serde_json::json!([{ "name": "low", "pbrMetallicRoughness": { "metallicFactor": 0.0 } }]);
+            crate::scene::material::give_plain_material(&mut json, &mut prim, "low");
         }
         while !bin.len().is_multiple_of(4) {
             bin.push(0);

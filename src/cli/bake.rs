@@ -1,7 +1,7 @@
 //! `bumpbake bake MESH [--height H | --normal N] -o OUT`.
 
 use bumpbake::bake::maps::HeightSettings;
-use bumpbake::bake::{run as run_job, BakeJob, BakeReport, MapSource};
+use bumpbake::bake::{run as run_job, BakeJob, MapSource};
 use bumpbake::batch;
 use bumpbake::format::WriteOptions;
 use bumpbake::normalmap::{Channel, Convention, Filter};
@@ -153,7 +153,7 @@ pub fn run(a: Args) -> Result<u8> {
     let results = batch::run(&a.io.inputs, &opts, |input| {
         run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
     })?;
-    super::report::print("bumpbake-bake/1", &a.io.inputs, results, a.batch.json, a.batch.quiet, BakeReport::text)
+    super::print::all(&a.io.inputs, results, a.batch.json, a.batch.quiet)
 }
 
 /// The `--from` options, checked; `None` without `--from`.

@@ -22,15 +22,11 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<u8> {
     let opts = ReadOptions { allow_outside: a.allow_outside, ..Default::default() };
+    // One file at a time, each printed as soon as it is read: a bad file is a record of its
+    // own, and the run ends with the worst exit code.
+    let mut printer = super::print::Printer::new(a.inputs.len(), a.json, false);
     for input in &a.inputs {
-        let i = bumpbake::inspect::inspect(input, &opts)?;
-        if a.json {
-            let mut v = serde_json::to_value(&i).expect("serialises");
-            v["schema"] = serde_json::json!("bumpbake-inspect/1");
-            outln!("{v}");
-        } else {
-            out!("{}", i.text());
-        }
+        printer.result(input, bumpbake::inspect::inspect(input, &opts))?;
     }
-    Ok(0)
+    Ok(printer.finish())
 }

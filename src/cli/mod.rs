@@ -9,6 +9,7 @@ mod completions;
 mod inspect;
 mod normalmap;
 mod preview;
+mod print;
 mod progress;
 mod report;
 mod tangents;

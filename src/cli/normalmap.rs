@@ -94,14 +94,17 @@ fn strength(args: &Args) -> Result<f32> {
     Ok(s)
 }
 
-/// What one conversion did, for `--json`.
+/// What one conversion did.
 #[derive(serde::Serialize)]
-struct Record {
-    input: PathBuf,
-    output: PathBuf,
-    timings_ms: bumpbake::report::Timings,
-    /// Said on stderr too: a map that came out (nearly) flat.
-    warnings: Vec<String>,
+pub struct Converted {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub timings_ms: bumpbake::report::Timings,
+    /// A map that came out (nearly) flat.
+    pub warnings: Vec<String>,
+    /// Whether this is one of several inputs (the text then names the files).
+    #[serde(skip)]
+    pub batch: bool,
 }
 
 pub fn run(args: Args) -> Result<u8> {
@@ -137,29 +140,20 @@ pub fn run(args: Args) -> Result<u8> {
                 .and_then(|c| nm::convert_file(&c, None))
         })?
     };
-    let records: Vec<Result<Record>> = results
+    let records: Vec<Result<Converted>> = results
         .into_iter()
         .zip(args.heights.iter().zip(&outputs))
         .map(|(r, (i, o))| {
-            r.map(|(t, w)| Record {
+            r.map(|(t, w)| Converted {
                 input: i.clone(),
                 output: o.clone(),
                 timings_ms: t,
                 warnings: w.into_iter().collect(),
+                batch: args.heights.len() > 1,
             })
         })
         .collect();
-    super::report::print("bumpbake-normalmap/1", &args.heights, records, args.batch.json, args.batch.quiet, |r| {
-        let mut s = if args.heights.len() > 1 {
-            format!("{} -> {}\n", r.input.display(), r.output.display())
-        } else {
-            String::new()
-        };
-        for w in &r.warnings {
-            s += &format!("bumpbake: warning: {}: {w}\n", r.input.display());
-        }
-        s
-    })
+    super::print::all(&args.heights, records, args.batch.json, args.batch.quiet)
 }
 
 /// Rows done, told to a bar on a terminal for maps big enough to wait for; nothing when piped or

@@ -1,7 +1,7 @@
 //! `bumpbake preview IN -o OUT.png` and `bumpbake preview --reference A --compare B -o diff.png`.
 
 use bumpbake::output::write_atomic;
-use bumpbake::preview::compare::{compare, DiffKind};
+use bumpbake::preview::compare::{compare, Comparison, DiffKind};
 use bumpbake::preview::{render, Camera, CameraSpec, Light, Options, Params, Prepared, View};
 use bumpbake::scene::{ReadOptions, Scene};
 use bumpbake::{Error, Result};
@@ -92,6 +92,40 @@ pub enum DiffArg {
     Shaded,
 }
 
+/// One picture rendered (`--json`: `docs/json.md`, preview).
+#[derive(serde::Serialize)]
+pub struct Rendered {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub view: &'static str,
+    pub width: u32,
+    pub height: u32,
+    pub ssaa: u32,
+    pub triangles: usize,
+    pub notes: Vec<String>,
+    pub time_ms: f64,
+    pub stages: Stages,
+}
+
+/// Where a preview's time went, in milliseconds.
+#[derive(serde::Serialize)]
+pub struct Stages {
+    pub read_ms: f64,
+    pub prepare_ms: f64,
+    pub render_ms: f64,
+    pub write_ms: f64,
+}
+
+/// `--compare`: the difference between two renders of the same view (`docs/preview.md`).
+#[derive(serde::Serialize)]
+pub struct Compared {
+    pub reference: PathBuf,
+    pub compare: PathBuf,
+    pub output: PathBuf,
+    pub time_ms: f64,
+    pub comparison: Comparison,
+}
+
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
     let p = |v: &str| {
@@ -171,34 +205,14 @@ pub fn run(a: Args) -> Result<u8> {
         };
         let (cmp, img) = compare(&r, &c, &opts, kind)?;
         write_atomic(&a.output, &img.to_png())?;
-        let ms = start.elapsed().as_secs_f64() * 1e3;
-        if a.json {
-            let j = serde_json::json!({
-                "reference": reference, "compare": cand, "output": a.output, "time_ms": ms, "comparison": cmp,
-            });
-            outln!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
-        } else if !a.quiet {
-            eprintln!(
-                "preview: {} vs {} -> {} ({}x{}, {:.0} ms)",
-                reference.display(),
-                cand.display(),
-                a.output.display(),
-                cmp.width,
-                cmp.height,
-                ms
-            );
-            eprintln!("  pixels compared {}, excluded near silhouettes {}", cmp.pixels_compared, cmp.pixels_excluded);
-            match cmp.normal_angle_deg {
-                Some(s) => {
-                    eprintln!("  shading-normal angle: mean {:.3}°, p95 {:.3}°, max {:.3}°", s.mean, s.p95, s.max)
-                }
-                None => eprintln!("  shading-normal angle: no pixels to compare"),
-            }
-            match cmp.psnr_db {
-                Some(p) => eprintln!("  shaded PSNR {p:.2} dB"),
-                None => eprintln!("  shaded PSNR: identical"),
-            }
-        }
+        let done = Compared {
+            reference: reference.clone(),
+            compare: cand.clone(),
+            output: a.output.clone(),
+            time_ms: start.elapsed().as_secs_f64() * 1e3,
+            comparison: cmp,
+        };
+        super::print::document(&done, a.json, a.quiet)?;
         return Ok(0);
     }
 
@@ -218,34 +232,23 @@ pub fn run(a: Args) -> Result<u8> {
     let t_render = start.elapsed().as_secs_f64() * 1e3;
     write_atomic(&a.output, &frame.to_png())?;
     let ms = start.elapsed().as_secs_f64() * 1e3;
-    let stages = serde_json::json!({ "read_ms": t_read, "prepare_ms": t_prep - t_read, "render_ms": t_render - t_prep, "write_ms": ms - t_render });
-    if a.json {
-        let j = serde_json::json!({
-            "input": input, "output": a.output, "view": opts.view.name(), "width": opts.width, "height": opts.height,
-            "ssaa": opts.ssaa, "triangles": prep.triangle_count(), "notes": prep.notes, "time_ms": ms, "stages": stages,
-        });
-        outln!("{}", serde_json::to_string_pretty(&j).expect("report serialises"));
-    } else if !a.quiet {
-        eprintln!(
-            "preview: {} -> {} ({}x{}, {} view, {} triangles, {:.0} ms)",
-            input.display(),
-            a.output.display(),
-            opts.width,
-            opts.height,
-            opts.view.name(),
-            prep.triangle_count(),
-            ms
-        );
-        eprintln!(
-            "  read {:.0} ms, prepare {:.0} ms, render {:.0} ms, write {:.0} ms",
-            t_read,
-            t_prep - t_read,
-            t_render - t_prep,
-            ms - t_render
-        );
-        for n in &prep.notes {
-            eprintln!("  note: {n}");
-        }
-    }
+    let done = Rendered {
+        input: input.clone(),
+        output: a.output.clone(),
+        view: opts.view.name(),
+        width: opts.width,
+        height: opts.height,
+        ssaa: opts.ssaa,
+        triangles: prep.triangle_count(),
+        notes: prep.notes,
+        time_ms: ms,
+        stages: Stages {
+            read_ms: t_read,
+            prepare_ms: t_prep - t_read,
+            render_ms: t_render - t_prep,
+            write_ms: ms - t_render,
+        },
+    };
+    super::print::document(&done, a.json, a.quiet)?;
     Ok(0)
 }

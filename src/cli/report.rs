@@ -1,5 +1,5 @@
-//! Printing per-file results the same way for every command that takes many inputs: a JSON
-//! Lines record per file (`status` ok or error), or text on stderr, and a summary for batches.
+//! The command line every command over many inputs shares: the inputs, where their outputs go,
+//! and how the batch runs (`print` prints its results).
 
 use bumpbake::batch::{self, BatchOptions};
 use bumpbake::{Error, Result};
@@ -86,53 +86,6 @@ pub fn outputs(
     };
     batch::unique_outputs(&outs)?;
     Ok(outs)
-}
-
-/// Prints every result; returns the exit code. `schema` names the record layout
-/// (`docs/json.md`). With one input its error is the command's error.
-pub fn print<R: serde::Serialize>(
-    schema: &str,
-    inputs: &[PathBuf],
-    results: Vec<Result<R>>,
-    json: bool,
-    quiet: bool,
-    text: impl Fn(&R) -> String,
-) -> Result<u8> {
-    let single = inputs.len() == 1;
-    let mut failed = Vec::new();
-    for (input, r) in inputs.iter().zip(results) {
-        match r {
-            Ok(rep) if json => {
-                let mut v = serde_json::to_value(&rep).expect("report serialises");
-                v["schema"] = serde_json::json!(schema);
-                v["status"] = serde_json::json!("ok");
-                outln!("{v}");
-            }
-            Ok(rep) => {
-                if !quiet {
-                    eprint!("{}", text(&rep));
-                }
-            }
-            Err(e) if single => return Err(e),
-            Err(e) => {
-                if json {
-                    outln!(
-                        "{}",
-                        serde_json::json!({ "schema": schema, "input": input, "status": "error", "exit_code": e.exit_code(), "error": e.to_string() })
-                    );
-                }
-                if !quiet {
-                    eprintln!("bumpbake: {e}");
-                }
-                failed.push(input.display().to_string());
-            }
-        }
-    }
-    if !single && !quiet {
-        let which = if failed.is_empty() { String::new() } else { format!(" ({})", failed.join(", ")) };
-        eprintln!("{} files: {} written, {} failed{which}", inputs.len(), inputs.len() - failed.len(), failed.len());
-    }
-    Ok(if failed.is_empty() { 0 } else { 2 })
 }
 
 /// The output paired with `input` in a batch.

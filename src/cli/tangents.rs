@@ -4,7 +4,7 @@ use bumpbake::batch;
 use bumpbake::format::WriteOptions;
 use bumpbake::scene::{NormalMode, ReadOptions};
 use bumpbake::tangent::apply::ApplyOptions;
-use bumpbake::tangent::command::{run as run_job, TangentsJob, TangentsReport};
+use bumpbake::tangent::command::{run as run_job, TangentsJob};
 use bumpbake::tangent::Options;
 use bumpbake::Result;
 use std::path::Path;
@@ -67,12 +67,5 @@ pub fn run(a: Args) -> Result<u8> {
     let results = batch::run(&a.io.inputs, &opts, |input| {
         run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
     })?;
-    super::report::print(
-        "bumpbake-tangents/1",
-        &a.io.inputs,
-        results,
-        a.batch.json,
-        a.batch.quiet,
-        TangentsReport::text,
-    )
+    super::print::all(&a.io.inputs, results, a.batch.json, a.batch.quiet)
 }

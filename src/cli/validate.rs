@@ -1,7 +1,8 @@
 //! `bumpbake validate IN...`.
 
+use super::print::{github, junit, sarif, validate as report, Human};
 use bumpbake::scene::ReadOptions;
-use bumpbake::validate::{self, report, Code, Convention, Options};
+use bumpbake::validate::{self, Code, Convention, Options};
 use bumpbake::{Error, Result};
 use std::path::PathBuf;
 
@@ -93,15 +94,15 @@ pub fn run(a: Args) -> Result<u8> {
     match a.format {
         Format::Text => {}
         Format::Json => outln!("{}", report::json(&rep)),
-        Format::Junit => out!("{}", report::junit(&rep)),
-        Format::Github => out!("{}", report::github(&rep)),
+        Format::Junit => out!("{}", junit::junit(&rep)),
+        Format::Github => out!("{}", github::github(&rep)),
         Format::Sarif => {
             let unusable: Vec<String> = failed.iter().map(|e| e.to_string()).collect();
-            outln!("{}", report::sarif(&rep, &unusable))
+            outln!("{}", sarif::sarif(&rep, &unusable))
         }
     }
     if !a.quiet {
-        eprint!("{}", report::text(&rep));
+        eprint!("{}", rep.human());
     }
     // Unusable files come last, each on its own line; they make the run exit 2.
     for e in &failed {

@@ -140,6 +140,7 @@ fn build(
         deps,
         height_maps: Vec::new(),
         ledger: Default::default(),
+        material_cache: Default::default(),
         own_images: false,
     };
     check_views(&scene)?;

@@ -105,6 +105,7 @@ fn empty_scene(path: &Path, opts: &ReadOptions, format: SourceFormat, deps: Vec<
         deps,
         height_maps: Vec::new(),
         ledger: Default::default(),
+        material_cache: Default::default(),
         own_images: true,
     }
 }

@@ -105,7 +105,7 @@ impl Prepared {
     pub fn with_frames(scene: &Scene, all_frames: bool) -> Result<Prepared> {
         let mut cx = Cx {
             scene,
-            mats: scene.materials(),
+            mats: scene.materials().clone(),
             all_frames,
             textures: HashMap::new(),
             materials: Vec::new(),

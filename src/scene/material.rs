@@ -13,55 +13,7 @@ use super::{as_index, PrimRef, Scene};
 use serde::Serialize;
 use serde_json::{json, Value};
 
-/// `KHR_texture_transform` on one texture-info object.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct UvTransform {
-    pub offset: [f32; 2],
-    /// Radians; rotates the UVs counter-clockwise (as the spec's example and three.js do).
-    pub rotation: f32,
-    pub scale: [f32; 2],
-}
-
-impl UvTransform {
-    /// The UV the texture is sampled at: `translation * rotation * scale * uv`, with the
-    /// rotation matrix rows `(cos, sin)` and `(-sin, cos)`.
-    /// Computed in f64 so that dequantizing transforms (gltfpack's) round once, at the end.
-    pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
-        let (s, c) = (self.rotation as f64).sin_cos();
-        let (u, v) = (uv[0] as f64 * self.scale[0] as f64, uv[1] as f64 * self.scale[1] as f64);
-        [(c * u + s * v + self.offset[0] as f64) as f32, (-s * u + c * v + self.offset[1] as f64) as f32]
-    }
-
-    /// The most a UV difference can grow through the transform (the larger of the scales).
-    pub fn max_stretch(&self) -> f64 {
-        (self.scale[0] as f64).abs().max((self.scale[1] as f64).abs())
-    }
-
-    /// Whether applying it changes nothing.
-    pub fn is_identity(&self) -> bool {
-        self.offset == [0.0, 0.0] && self.rotation == 0.0 && self.scale == [1.0, 1.0]
-    }
-
-    /// The transform a texture-info's extension describes, or `None` for none or the identity.
-    pub fn from_texture_info(info: &Value) -> Option<UvTransform> {
-        let t = info.pointer("/extensions/KHR_texture_transform")?;
-        let pair = |key: &str, default: [f32; 2]| {
-            t.get(key)
-                .and_then(|v| v.as_array())
-                .filter(|a| a.len() == 2)
-                .and_then(|a| Some([a[0].as_f64()? as f32, a[1].as_f64()? as f32]))
-                .filter(|p| p.iter().all(|x| x.is_finite()))
-                .unwrap_or(default)
-        };
-        let rotation = t.get("rotation").and_then(|r| r.as_f64()).map(|r| r as f32).filter(|r| r.is_finite());
-        let tr = UvTransform {
-            offset: pair("offset", [0.0, 0.0]),
-            rotation: rotation.unwrap_or(0.0),
-            scale: pair("scale", [1.0, 1.0]),
-        };
-        (!tr.is_identity()).then_some(tr)
-    }
-}
+pub use super::texcoord::UvTransform;
 
 /// How a texture's texels are to be read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -164,6 +116,10 @@ pub struct TextureUse {
     pub texture: usize,
     /// The UV set read: `KHR_texture_transform`'s `texCoord` where given, else `texCoord`, else 0.
     pub tex_coord: u32,
+    /// The texture-info's own `texCoord` (else 0): what a client without `KHR_texture_transform`
+    /// reads, so leave-out keeps it too. Not in `inspect`'s JSON, whose schema stays as it was.
+    #[serde(skip)]
+    pub base_tex_coord: u32,
     /// `KHR_texture_transform`, unless it changes nothing.
     pub transform: Option<UvTransform>,
     pub sampler: Option<usize>,
@@ -277,14 +233,14 @@ impl Materials {
 
     /// The material a primitive shows by default.
     pub fn default_of(&self, scene: &Scene, r: PrimRef) -> Option<&MaterialInfo> {
-        scene.prim_json(r).get("material").and_then(as_index).and_then(|m| self.get(m))
+        scene.material_index(r).and_then(|m| self.get(m))
     }
 
     /// Every material the primitive can show: its own first, then its variants' in ascending
     /// order (each once). Indices that name no material are left out.
     pub fn of_primitive(&self, scene: &Scene, r: PrimRef) -> Vec<usize> {
         let pj = scene.prim_json(r);
-        let own = pj.get("material").and_then(as_index).filter(|&m| m < self.list.len());
+        let own = scene.material_index(r).filter(|&m| m < self.list.len());
         let mut variants: Vec<usize> = pj
             .pointer("/extensions/KHR_materials_variants/mappings")
             .and_then(|m| m.as_array())
@@ -301,7 +257,7 @@ impl Materials {
     /// The tangents a primitive needs: from its own material's first need, else from its
     /// lowest-numbered variant material that has one. None when no material it can show needs them.
     pub fn tangent_need(&self, scene: &Scene, r: PrimRef) -> Option<PrimNeed> {
-        let own = scene.prim_json(r).get("material").and_then(as_index);
+        let own = scene.material_index(r);
         let all = self.of_primitive(scene, r);
         let mut needs = all.iter().flat_map(|&m| self.list[m].tangent_needs.iter().map(move |n| (m, n)));
         let (material, need) = needs.next()?;
@@ -372,30 +328,41 @@ fn uv_words(n: &TangentNeed) -> String {
 }
 
 impl Scene {
-    /// Reads every material once. The result describes the document as it is now: a stage that
-    /// changes materials reads them again.
-    pub fn materials(&self) -> Materials {
-        let list = self.array("materials").iter().enumerate().map(|(i, m)| self.material_info(i, m)).collect();
-        Materials { list }
+    /// Every material, read once and kept until the materials change: the one reading of material
+    /// JSON that every stage asks. The methods that change the JSON of materials or textures
+    /// (here and in `leave_out.rs`) drop it with `materials_changed`; code outside `scene/`
+    /// changes them only through those methods (`tests/materials.rs` holds that). Images are not
+    /// part of it: a texture names its images by index, and adding or replacing an image leaves
+    /// every index in place.
+    pub fn materials(&self) -> &Materials {
+        self.material_cache.get_or_init(|| {
+            let list = self.array("materials").iter().enumerate().map(|(i, m)| self.material_info(i, m)).collect();
+            Materials { list }
+        })
+    }
+
+    /// The material a primitive names (its `material`), whether or not the document has it.
+    pub fn material_index(&self, r: PrimRef) -> Option<usize> {
+        self.prim_json(r).get("material").and_then(as_index)
+    }
+
+    /// Forgets the materials read, after a change to the JSON of materials or textures.
+    pub(crate) fn materials_changed(&mut self) {
+        self.material_cache.take();
     }
 
     fn material_info(&self, index: usize, m: &Value) -> MaterialInfo {
+        let infos = super::refs::texture_info_pointers(m);
         let mut textures = Vec::new();
+        // The slots of the table in its order, then texture-info objects of extensions it does
+        // not list.
         for &(slot, pointer, colour) in SLOTS {
-            if let Some(t) = m.pointer(pointer).and_then(|info| self.texture_use(slot, pointer, colour, info)) {
-                textures.push(t);
+            if infos.iter().any(|p| p == pointer) {
+                textures.extend(m.pointer(pointer).and_then(|info| self.texture_use(slot, pointer, colour, info)));
             }
         }
-        // Texture-info objects of extensions the table does not list, found the way the
-        // reference walkers find them.
-        let mut other = Vec::new();
-        collect_infos(m, String::new(), &mut other);
-        for (pointer, info) in other {
-            if !SLOTS.iter().any(|(_, p, _)| *p == pointer) {
-                if let Some(t) = self.texture_use(Slot::Other, &pointer, Linear, info) {
-                    textures.push(t);
-                }
-            }
+        for pointer in infos.iter().filter(|p| !SLOTS.iter().any(|(_, s, _)| s == p)) {
+            textures.extend(m.pointer(pointer).and_then(|info| self.texture_use(Slot::Other, pointer, Linear, info)));
         }
         let mut tangent_needs = Vec::new();
         for slot in [Slot::Normal, Slot::ClearcoatNormal] {
@@ -430,7 +397,9 @@ impl Scene {
 
     fn texture_use(&self, slot: Slot, pointer: &str, colour: ColourSpace, info: &Value) -> Option<TextureUse> {
         let texture = info.get("index").and_then(as_index)?;
-        let tex_coord = super::texcoord::effective_set(info);
+        let base_tex_coord = info.get("texCoord").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
+        let over = info.pointer("/extensions/KHR_texture_transform/texCoord").and_then(|c| c.as_u64());
+        let tex_coord = over.map_or(base_tex_coord, |c| c as u32);
         let tj = self.array("textures").get(texture);
         // The plain source first (the core formats), then the extensions' in the order a client
         // prefers them.
@@ -446,12 +415,30 @@ impl Scene {
             pointer: pointer.to_string(),
             texture,
             tex_coord,
+            base_tex_coord,
             transform: UvTransform::from_texture_info(info),
             sampler: tj.and_then(|t| t.get("sampler")).and_then(as_index),
             images,
             colour,
             scale: info.get(scale_key).and_then(|s| s.as_f64()).filter(|s| s.is_finite()),
         })
+    }
+
+    /// A scene without materials gets a plain one (untextured, not metallic), shown by every
+    /// primitive without a material, so that a map has somewhere to go.
+    pub fn ensure_material(&mut self) {
+        if !self.array("materials").is_empty() {
+            return;
+        }
+        let rs = self.primitives();
+        let m = push_plain_material(&mut self.json, "bumpbake");
+        for r in rs {
+            let pj = self.prim_json_mut(r);
+            if pj.get("material").is_none() {
+                pj["material"] = json!(m);
+            }
+        }
+        self.materials_changed();
     }
 
     /// Gives material `m` texture `texture` as its normal texture (UV set 0), keeping the scale
@@ -464,6 +451,7 @@ impl Scene {
             info["scale"] = Value::Number(n);
         }
         mat["normalTexture"] = info;
+        self.materials_changed();
     }
 
     /// Adds a texture showing `image` through `sampler`; returns its index.
@@ -474,7 +462,18 @@ impl Scene {
         }
         let textures = super::array_mut(&mut self.json, "textures");
         textures.push(tex);
-        textures.len() - 1
+        let t = textures.len() - 1;
+        self.materials_changed();
+        t
+    }
+
+    /// Puts the PNG `png` in place of image `img`, keeping its index and name.
+    pub fn replace_image(&mut self, img: usize, png: &[u8]) {
+        let name = self.array("images").get(img).and_then(|i| i.get("name")).and_then(|n| n.as_str()).map(String::from);
+        let new = self.push_image(png, "image/png", name.as_deref());
+        let images = super::array_mut(&mut self.json, "images");
+        images.swap(img, new);
+        images.pop();
     }
 
     /// The `wrapS` mode of a sampler (glTF's default, repeat, when there is none).
@@ -497,16 +496,19 @@ impl Scene {
     }
 }
 
-fn collect_infos<'a>(v: &'a Value, at: String, out: &mut Vec<(String, &'a Value)>) {
-    if let Some(o) = v.as_object() {
-        for (k, child) in o {
-            let p = format!("{at}/{k}");
-            if k.ends_with("Texture") && child.get("index").is_some() {
-                out.push((p.clone(), child));
-            }
-            collect_infos(child, p, out);
-        }
-    }
+/// Appends a plain material named `name` to the glTF document `doc` and returns its index:
+/// untextured and not metallic (glTF's default metallic factor of 1 looks black without an
+/// environment to reflect), for meshes that come without one.
+fn push_plain_material(doc: &mut Value, name: &str) -> usize {
+    let materials = super::array_mut(doc, "materials");
+    materials.push(json!({ "name": name, "pbrMetallicRoughness": { "metallicFactor": 0.0 } }));
+    materials.len() - 1
+}
+
+/// Gives `prim`, a primitive's JSON about to join the document `doc`, a new plain material named
+/// `name` (for documents built by hand, as `bench transfer`'s LOW).
+pub fn give_plain_material(doc: &mut Value, prim: &mut Value, name: &str) {
+    prim["material"] = json!(push_plain_material(doc, name));
 }
 
 #[cfg(test)]
@@ -517,17 +519,6 @@ mod tests {
 
     fn scene(j: Value) -> Scene {
         Scene::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&j).unwrap(), &ReadOptions::default()).unwrap()
-    }
-
-    #[test]
-    fn rotation_turns_uvs_counter_clockwise() {
-        // The spec's example: the lower-left quadrant, rotated clockwise 90 degrees.
-        let t = UvTransform { offset: [0.0, 1.0], rotation: std::f32::consts::FRAC_PI_2, scale: [0.5, 0.5] };
-        let close = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
-        assert!(close(t.apply([0.0, 0.0]), [0.0, 1.0]));
-        assert!(close(t.apply([1.0, 0.0]), [0.0, 0.5]));
-        assert!(close(t.apply([0.0, 1.0]), [0.5, 1.0]));
-        assert!(close(t.apply([1.0, 1.0]), [0.5, 0.5]));
     }
 
     #[test]

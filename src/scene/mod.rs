@@ -8,6 +8,7 @@
 
 pub mod accessor;
 pub(crate) mod compact;
+pub mod leave_out;
 pub mod material;
 pub mod nodes;
 pub mod normals;
@@ -99,6 +100,8 @@ pub struct Scene {
     pub height_maps: Vec<HeightMapRef>,
     /// What compaction and appending did, for the writer's report.
     pub(crate) ledger: compact::Ledger,
+    /// [`Scene::materials`], once read.
+    pub(crate) material_cache: std::sync::OnceLock<material::Materials>,
 }
 
 /// A height map a material wants as its bump map.
@@ -226,15 +229,14 @@ impl Scene {
 
     /// The material JSON of a primitive, if it has one.
     pub fn material_of(&self, r: PrimRef) -> Option<&Value> {
-        let m = self.prim_json(r).get("material")?.as_u64()? as usize;
-        self.array("materials").get(m)
+        self.array("materials").get(self.material_index(r)?)
     }
 
     /// The UV set the primitive's own material's normal texture reads, if it has one: then the
     /// set its tangents follow ([`PrimView::tangent_uvs`]). See [`Scene::materials`] for
     /// everything else a material reads and needs.
     pub fn normal_texcoord(&self, r: PrimRef) -> Option<u32> {
-        let view = PrimView::new(self, &self.materials(), r);
+        let view = PrimView::new(self, self.materials(), r);
         let need = view.tangent_need.as_ref().filter(|n| !n.variant && n.need.slot == Slot::Normal);
         need.map(|_| view.tangent_uvs().set)
     }
@@ -242,7 +244,7 @@ impl Scene {
     /// The transform that the UVs deciding the primitive's tangents go through (the
     /// `KHR_texture_transform` of the texture that needs them), if any: [`PrimView::tangent_uvs`].
     pub fn normal_uv_transform(&self, r: PrimRef) -> Option<UvTransform> {
-        PrimView::new(self, &self.materials(), r).tangent_uvs().transform
+        PrimView::new(self, self.materials(), r).tangent_uvs().transform
     }
 
     /// The primitive as its accessors declare it, for listing: the same as

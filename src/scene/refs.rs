@@ -164,27 +164,39 @@ pub fn material_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSe
     seen
 }
 
-/// Every texture reference: the texture-info objects of every material (`baseColorTexture`,
-/// `normalTexture`, and those of material extensions, known or not: any `...Texture` object with
-/// an `index`).
+/// Every texture reference: the `index` of every texture-info object of every material (see
+/// [`texture_info_pointers`]).
 pub fn texture_refs(json: &mut Value, f: &mut dyn FnMut(&mut usize)) -> BTreeSet<usize> {
     let mut seen = BTreeSet::new();
     for m in arr_mut(json, "materials") {
-        texture_infos(m, &mut |t| visit_index(&mut t["index"], &mut seen, f));
+        for p in texture_info_pointers(m) {
+            if let Some(i) = m.pointer_mut(&p).and_then(|t| t.get_mut("index")) {
+                visit_index(i, &mut seen, f);
+            }
+        }
     }
     seen
 }
 
-/// Every texture-info object below `v`, the material JSON.
-pub fn texture_infos(v: &mut Value, f: &mut dyn FnMut(&mut Value)) {
-    if let Some(o) = v.as_object_mut() {
-        for (k, child) in o.iter_mut() {
+/// Where a material's texture-info objects sit, as JSON pointers into the material, in document
+/// order: every object under a key ending in `Texture` that has an `index` (`baseColorTexture`,
+/// `normalTexture`, and those of material extensions, known or not, at any depth). The one walk
+/// over a material's textures: [`crate::scene::Materials`] reads them through it, and
+/// [`texture_refs`] follows their references.
+pub fn texture_info_pointers(material: &Value) -> Vec<String> {
+    fn walk(v: &Value, at: &str, out: &mut Vec<String>) {
+        for (k, child) in v.as_object().into_iter().flatten() {
+            // RFC 6901 escapes, so that the pointer finds the key again.
+            let p = format!("{at}/{}", k.replace('~', "~0").replace('/', "~1"));
             if k.ends_with("Texture") && child.get("index").is_some() {
-                f(child);
+                out.push(p.clone());
             }
-            texture_infos(child, f);
+            walk(child, &p, out);
         }
     }
+    let mut out = Vec::new();
+    walk(material, "", &mut out);
+    out
 }
 
 /// Every image reference: each texture's `source` and the sources of image-format extensions.
@@ -329,6 +341,29 @@ mod tests {
         assert_eq!(texture_refs(&mut j, &mut |_| {}), BTreeSet::from([1, 3]));
         assert_eq!(image_refs(&mut j, &mut |_| {}), BTreeSet::from([0, 1, 2, 3]));
         assert_eq!(sampler_refs(&mut j, &mut |_| {}), BTreeSet::from([1]));
+    }
+
+    #[test]
+    fn texture_infos_are_found_at_any_depth_in_document_order() {
+        let m = json!({
+            "normalTexture": { "index": 0 },
+            "occlusionTexture": { "texCoord": 1 },
+            "extensions": {
+                "EXT_odd/name": { "oddTexture": { "index": 1 }, "nested": { "deepTexture": { "index": 2 } } },
+            },
+            "pbrMetallicRoughness": { "baseColorTexture": { "index": 3 } },
+        });
+        let p = texture_info_pointers(&m);
+        assert_eq!(
+            p,
+            [
+                "/normalTexture",
+                "/extensions/EXT_odd~1name/oddTexture",
+                "/extensions/EXT_odd~1name/nested/deepTexture",
+                "/pbrMetallicRoughness/baseColorTexture",
+            ]
+        );
+        assert!(p.iter().all(|p| m.pointer(p).is_some()));
     }
 
     #[test]

@@ -1,40 +1,60 @@
-//! Which UV sets (`TEXCOORD_n`) a material's textures read, and how a group of primitives and
-//! the materials they share can renumber their sets so that only the read ones remain, numbered
-//! from 0 without gaps (glTF wants `TEXCOORD_0..n`).
+//! The UVs a texture is sampled at: the `KHR_texture_transform` applied to them, and how a group
+//! of primitives and the materials they share can renumber their UV sets (`TEXCOORD_n`) so that
+//! only the read ones remain, numbered from 0 without gaps (glTF wants `TEXCOORD_0..n`).
 
+use super::material::MaterialInfo;
+use serde::Serialize;
 use serde_json::{json, Value};
 use std::collections::{BTreeMap, BTreeSet};
 
-/// Calls `f` on every texture-info object of a material (`baseColorTexture`, `normalTexture`,
-/// the textures of material extensions): an object under a key ending in `Texture` with an
-/// `index`.
-pub fn texture_infos(v: &Value, f: &mut dyn FnMut(&str, &Value)) {
-    if let Some(o) = v.as_object() {
-        for (k, child) in o {
-            if k.ends_with("Texture") && child.get("index").is_some() {
-                f(k, child);
-            }
-            texture_infos(child, f);
-        }
+/// `KHR_texture_transform` on one texture-info object.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct UvTransform {
+    pub offset: [f32; 2],
+    /// Radians; rotates the UVs counter-clockwise (as the spec's example and three.js do).
+    pub rotation: f32,
+    pub scale: [f32; 2],
+}
+
+impl UvTransform {
+    /// The UV the texture is sampled at: `translation * rotation * scale * uv`, with the
+    /// rotation matrix rows `(cos, sin)` and `(-sin, cos)`.
+    /// Computed in f64 so that dequantizing transforms (gltfpack's) round once, at the end.
+    pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
+        let (s, c) = (self.rotation as f64).sin_cos();
+        let (u, v) = (uv[0] as f64 * self.scale[0] as f64, uv[1] as f64 * self.scale[1] as f64);
+        [(c * u + s * v + self.offset[0] as f64) as f32, (-s * u + c * v + self.offset[1] as f64) as f32]
     }
-}
 
-/// [`texture_infos`] for changing them.
-pub fn texture_infos_mut(v: &mut Value, f: &mut dyn FnMut(&mut Value)) {
-    super::refs::texture_infos(v, f)
-}
+    /// The most a UV difference can grow through the transform (the larger of the scales).
+    pub fn max_stretch(&self) -> f64 {
+        (self.scale[0] as f64).abs().max((self.scale[1] as f64).abs())
+    }
 
-/// The set a texture info reads: `KHR_texture_transform`'s override, else `texCoord`, else 0.
-pub fn effective_set(info: &Value) -> u32 {
-    let over = info.pointer("/extensions/KHR_texture_transform/texCoord").and_then(|c| c.as_u64());
-    over.or_else(|| info.get("texCoord").and_then(|c| c.as_u64())).unwrap_or(0) as u32
-}
+    /// Whether applying it changes nothing.
+    pub fn is_identity(&self) -> bool {
+        self.offset == [0.0, 0.0] && self.rotation == 0.0 && self.scale == [1.0, 1.0]
+    }
 
-/// Every set a texture info names: the effective one and, under an override, the `texCoord`
-/// that clients without `KHR_texture_transform` read.
-fn named_sets(info: &Value) -> impl Iterator<Item = u32> {
-    let base = info.get("texCoord").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
-    [base, effective_set(info)].into_iter()
+    /// The transform a texture-info's extension describes, or `None` for none or the identity.
+    pub fn from_texture_info(info: &Value) -> Option<UvTransform> {
+        let t = info.pointer("/extensions/KHR_texture_transform")?;
+        let pair = |key: &str, default: [f32; 2]| {
+            t.get(key)
+                .and_then(|v| v.as_array())
+                .filter(|a| a.len() == 2)
+                .and_then(|a| Some([a[0].as_f64()? as f32, a[1].as_f64()? as f32]))
+                .filter(|p| p.iter().all(|x| x.is_finite()))
+                .unwrap_or(default)
+        };
+        let rotation = t.get("rotation").and_then(|r| r.as_f64()).map(|r| r as f32).filter(|r| r.is_finite());
+        let tr = UvTransform {
+            offset: pair("offset", [0.0, 0.0]),
+            rotation: rotation.unwrap_or(0.0),
+            scale: pair("scale", [1.0, 1.0]),
+        };
+        (!tr.is_identity()).then_some(tr)
+    }
 }
 
 /// What renumbering needs to know of one primitive.
@@ -56,7 +76,7 @@ pub struct Renumbering {
 }
 
 /// Plans the renumbering. `named[m]` is every set material `m`'s textures name
-/// (see [`material_named_sets`]). Primitives that share a material (directly or through another
+/// (see [`named_sets`]). Primitives that share a material (directly or through another
 /// primitive) form a group that must agree; a group is renumbered when every primitive in it has
 /// every set its materials name, so that no texture loses its coordinates.
 pub fn plan(prims: &[PrimSets], named: &[BTreeSet<u32>]) -> Renumbering {
@@ -110,30 +130,28 @@ pub fn plan(prims: &[PrimSets], named: &[BTreeSet<u32>]) -> Renumbering {
     out
 }
 
-/// Every set a material's textures name (see [`plan`]).
-pub fn material_named_sets(material: &Value) -> BTreeSet<u32> {
-    let mut sets = BTreeSet::new();
-    texture_infos(material, &mut |_, t| sets.extend(named_sets(t)));
-    sets
+/// Every set a material's textures name (see [`plan`]): the set each reads and, under a
+/// `KHR_texture_transform` override, the `texCoord` that clients without the extension read.
+pub fn named_sets(material: &MaterialInfo) -> BTreeSet<u32> {
+    material.textures.iter().flat_map(|t| [t.base_tex_coord, t.tex_coord]).collect()
 }
 
-/// Rewrites a material's `texCoord`s (and overrides) through `map`.
-pub fn renumber_material(material: &mut Value, map: &BTreeMap<u32, u32>) {
-    texture_infos_mut(material, &mut |t| {
-        let base = t.get("texCoord").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
-        let new = map.get(&base).copied().unwrap_or(base);
-        if new == 0 {
-            if let Some(o) = t.as_object_mut() {
-                o.remove("texCoord");
+/// Rewrites the `texCoord`s (and overrides) of `material`, the JSON `info` was read from,
+/// through `map`.
+pub fn renumber_material(material: &mut Value, info: &MaterialInfo, map: &BTreeMap<u32, u32>) {
+    let to = |set: u32| map.get(&set).copied().unwrap_or(set);
+    for t in &info.textures {
+        let Some(ti) = material.pointer_mut(&t.pointer) else { continue };
+        match to(t.base_tex_coord) {
+            0 => {
+                ti.as_object_mut().map(|o| o.remove("texCoord"));
             }
-        } else {
-            t["texCoord"] = json!(new);
+            new => ti["texCoord"] = json!(new),
         }
-        if let Some(c) = t.pointer_mut("/extensions/KHR_texture_transform/texCoord") {
-            let old = c.as_u64().unwrap_or(0) as u32;
-            *c = json!(map.get(&old).copied().unwrap_or(old));
+        if let Some(c) = ti.pointer_mut("/extensions/KHR_texture_transform/texCoord") {
+            *c = json!(to(t.tex_coord));
         }
-    });
+    }
 }
 
 /// Renames a primitive's `TEXCOORD_n` attributes (and its morph targets') through `map`, removing
@@ -184,6 +202,17 @@ mod tests {
     }
 
     #[test]
+    fn rotation_turns_uvs_counter_clockwise() {
+        // The spec's example: the lower-left quadrant, rotated clockwise 90 degrees.
+        let t = UvTransform { offset: [0.0, 1.0], rotation: std::f32::consts::FRAC_PI_2, scale: [0.5, 0.5] };
+        let close = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
+        assert!(close(t.apply([0.0, 0.0]), [0.0, 1.0]));
+        assert!(close(t.apply([1.0, 0.0]), [0.0, 0.5]));
+        assert!(close(t.apply([0.0, 1.0]), [0.5, 1.0]));
+        assert!(close(t.apply([1.0, 1.0]), [0.5, 0.5]));
+    }
+
+    #[test]
     fn a_group_reading_only_set_1_moves_it_to_0() {
         let plan = plan(&[prim(&[0], &[0, 1]), prim(&[0], &[0, 1])], &[sets(&[1])]);
         let want = BTreeMap::from([(1, 0)]);
@@ -212,7 +241,16 @@ mod tests {
         assert_eq!(renumber_primitive(&mut p, &map), vec![("TEXCOORD_0".to_string(), Some(1))]);
         assert_eq!(p, json!({ "attributes": { "POSITION": 0, "TEXCOORD_0": 2 }, "targets": [{ "TEXCOORD_0": 5 }] }));
         let mut m = json!({ "normalTexture": { "index": 0, "texCoord": 1 }, "occlusionTexture": { "index": 1, "texCoord": 1, "extensions": { "KHR_texture_transform": { "texCoord": 1 } } } });
-        renumber_material(&mut m, &map);
+        let doc = json!({ "asset": { "version": "2.0" }, "materials": [m] });
+        let scene = crate::scene::Scene::read_bytes(
+            std::path::Path::new("m.gltf"),
+            &serde_json::to_vec(&doc).unwrap(),
+            &crate::scene::ReadOptions::default(),
+        )
+        .unwrap();
+        let info = &scene.materials().list[0];
+        assert_eq!(named_sets(info), sets(&[1]));
+        renumber_material(&mut m, info, &map);
         assert_eq!(
             m,
             json!({ "normalTexture": { "index": 0 }, "occlusionTexture": { "index": 1, "extensions": { "KHR_texture_transform": { "texCoord": 0 } } } })

@@ -247,7 +247,7 @@ mod tests {
             ] }],
         }));
         let mats = s.materials();
-        let v = views(&s, &mats);
+        let v = views(&s, mats);
         assert_eq!(v[0].tangent_uvs().set, 1);
         assert_eq!(v[0].tangent_uvs().transform.map(|t| t.scale), Some([2.0, 2.0]));
         assert!(v[0].own_material_needs_tangents() && v[0].has_position && v[0].mode.has_triangles());

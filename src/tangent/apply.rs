@@ -69,7 +69,7 @@ pub fn needs_tangents(view: &PrimView, all: bool) -> std::result::Result<(), Str
 pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> {
     let mut reports = Vec::new();
     let mut work: Vec<(PrimRef, Geometry)> = Vec::new();
-    let mats = scene.materials();
+    let mats = scene.materials().clone();
     for view in views(scene, &mats) {
         let r = view.at;
         let report = |action, reason: Option<String>, with_uvs: bool| PrimReport {

@@ -49,10 +49,10 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     }
     t.time("write", || files.commit())?;
     crate::report::mem_mark("write");
-    let mut notes = scene.notes;
+    let mut notes = std::mem::take(&mut scene.notes);
     // `bake` converts these; `tangents` leaves them, and says so.
     for h in &scene.height_maps {
-        let name = scene.json.pointer(&format!("/materials/{}/name", h.material)).and_then(|n| n.as_str());
+        let name = scene.materials().get(h.material).and_then(|m| m.name.as_deref());
         notes.push(format!(
             "material '{}': bump map '{}' is a height map, left out; `bumpbake bake` converts it to a normal map",
             name.unwrap_or("(unnamed)"),
@@ -85,65 +85,5 @@ fn summarise(
         notes,
         written,
         timings_ms: t,
-    }
-}
-
-impl TangentsReport {
-    /// The human summary.
-    pub fn text(&self) -> String {
-        let mut s = format!(
-            "{} -> {}: {} primitives got tangents, {} kept theirs, {} skipped\n",
-            self.input.display(),
-            self.output.display(),
-            self.generated,
-            self.kept,
-            self.skipped
-        );
-        for p in &self.primitives {
-            let at = format!("  mesh {} primitive {}", p.mesh, p.primitive);
-            match (&p.stats, &p.reason) {
-                (Some(st), _) => {
-                    s += &format!(
-                        "{at}: TEXCOORD_{} {} tris, vertices {} -> {}",
-                        p.uv_set.unwrap_or(0),
-                        st.triangles,
-                        st.vertices_in,
-                        st.vertices_out
-                    );
-                    if st.fallback.total() > 0 {
-                        s += &format!(
-                            ", {} fallback frames ({} undefined, {} invalid)",
-                            st.fallback.total(),
-                            st.fallback.undefined,
-                            st.fallback.invalid
-                        );
-                    }
-                    if st.generated_normals {
-                        s += ", flat normals generated (NORMAL was missing)";
-                    }
-                    if let Some(r) = &p.reason {
-                        s += &format!("; {r}");
-                    }
-                    s += "\n";
-                }
-                (None, Some(r)) => s += &format!("{at}: {}: {r}\n", p.action),
-                (None, None) => s += &format!("{at}: {}\n", p.action),
-            }
-        }
-        for n in &self.notes {
-            s += &format!("  note: {n}\n");
-        }
-        if self.written.accessors_dropped > 0 {
-            s += &format!(
-                "  dropped {} unreferenced accessors, {} buffer views ({} -> {} buffer bytes)\n",
-                self.written.accessors_dropped,
-                self.written.buffer_views_dropped,
-                self.written.buffer_bytes_in,
-                self.written.buffer_bytes_out
-            );
-        }
-        let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
-        s += &format!("  time: {}\n", times.join(", "));
-        s
     }
 }

@@ -234,7 +234,7 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
         let r = pl.prim;
         // The map is laid out in the UVs the renderer samples the normal texture with, the ones
         // the tangents follow (the view's one rule).
-        let view = PrimView::new(scene, &mats, r);
+        let view = PrimView::new(scene, mats, r);
         let uv_set = view.tangent_uvs();
         let g = view.read(scene)?;
         let p = &g.primitive;

@@ -129,10 +129,7 @@ pub fn material_prims(scene: &Scene, m: usize) -> Vec<PrimRef> {
     scene
         .primitives()
         .into_iter()
-        .filter(|&r| {
-            scene.prim_json(r).get("material").and_then(|x| x.as_u64()) == Some(m as u64)
-                && mesh::is_triangles(scene, r)
-        })
+        .filter(|&r| scene.material_index(r) == Some(m) && mesh::is_triangles(scene, r))
         .collect()
 }
 

@@ -20,7 +20,6 @@ pub mod frames;
 pub mod handedness;
 pub mod lossy;
 pub mod normal_image;
-pub mod report;
 mod scene_checks;
 
 pub use codes::{Code, Severity};

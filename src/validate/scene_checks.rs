@@ -17,12 +17,12 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     // Reading is cheap and may fail (exit 2); checking is the expensive part and runs in parallel.
     let mut subjects = Vec::new();
     let mats = scene.materials();
-    for view in views(scene, &mats) {
+    for view in views(scene, mats) {
         let r = view.at;
         let mut s = Subject::new("primitive", prim_name(scene, r));
         s.mesh = Some(r.mesh);
         s.primitive = Some(r.primitive);
-        check_texcoords(scene, &mats, r, &mut s);
+        check_texcoords(scene, mats, r, &mut s);
         // A compressed primitive whose normal map needs frames is a warning: its frames go
         // unchecked, and `--strict` must not pass them silently.
         let (code, why) = if let Some(why) = crate::format::draco::why_unreadable(scene, r) {
@@ -85,7 +85,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
     if let Some(s) = check_nodes(scene) {
         done.push(s);
     }
-    done.extend(check_images(scene, &mats));
+    done.extend(check_images(scene, mats));
     Ok(done)
 }
 

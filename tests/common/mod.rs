@@ -319,12 +319,12 @@ pub fn data_uri(mime: &str, bytes: &[u8]) -> String {
     format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(bytes))
 }
 
-/// Every line of the crate's sources outside `src/scene/` (the model) and `src/format/` (the
-/// readers that build it) that contains one of `lookups`, as `path:line: text`: what guard tests
-/// use to keep a decision in the model.
-pub fn stage_lines_containing(lookups: &[&str]) -> Vec<String> {
+/// Every line of code (comments left out) of the crate's sources outside `src/scene/` (the
+/// model) and `src/format/` (the readers that build it) for which `found` holds, as
+/// `path:line: text`: what guard tests use to keep a decision in the model.
+pub fn stage_lines_where(found: impl Fn(&str) -> bool) -> Vec<String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut found = Vec::new();
+    let mut out = Vec::new();
     let mut stack = vec![root.clone()];
     while let Some(dir) = stack.pop() {
         for e in std::fs::read_dir(&dir).unwrap() {
@@ -335,13 +335,13 @@ pub fn stage_lines_containing(lookups: &[&str]) -> Vec<String> {
                 }
             } else if p.extension().is_some_and(|x| x == "rs") {
                 let text = std::fs::read_to_string(&p).unwrap();
-                for (n, line) in text.lines().enumerate() {
-                    if lookups.iter().any(|l| line.contains(l)) {
-                        found.push(format!("{}:{}: {}", p.display(), n + 1, line.trim()));
+                for (n, line) in text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with("//")) {
+                    if found(line) {
+                        out.push(format!("{}:{}: {}", p.display(), n + 1, line.trim()));
                     }
                 }
             }
         }
     }
-    found
+    out
 }

@@ -1,8 +1,8 @@
-//! SARIF 2.1.0, the format GitHub code scanning and most CI dashboards ingest: one result per
+//! `validate --format sarif`: SARIF 2.1.0, the format GitHub code scanning and most CI dashboards ingest: one result per
 //! finding, its rule the check code, located by the file (physical location) and the glTF element
 //! inside it (logical location, e.g. `meshes/0/primitives/1`, `images/2`, `nodes/3`).
 
-use crate::validate::{Code, FileReport, Finding, Report, Severity, Subject};
+use bumpbake::validate::{Code, FileReport, Finding, Report, Severity, Subject};
 use serde_json::{json, Value};
 use std::path::{Component, Path};
 
