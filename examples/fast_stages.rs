@@ -15,7 +15,7 @@ fn main() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
     pool.install(|| {
         for _ in 0..5 {
-            let mut t = bumpbake::report::Timings::default();
+            let mut t = bumpbake::timings::Timings::default();
             let s0 = schedstat();
             let t0 = std::time::Instant::now();
             let out = bumpbake::tangent::fast::generate_timed(&case.mesh(), &mut t).expect("valid");

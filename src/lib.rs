@@ -24,9 +24,9 @@ pub mod normalmap;
 pub mod output;
 pub mod preview;
 pub mod progress;
-pub mod report;
 pub mod scene;
 pub mod tangent;
+pub mod timings;
 pub mod transfer;
 pub mod validate;
 

@@ -357,28 +357,11 @@ fn json_keys(line: &str) -> Vec<&str> {
 /// material reads.
 #[test]
 fn only_the_scene_model_reads_material_json() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut bad = Vec::new();
-    let mut stack = vec![root.clone()];
-    while let Some(dir) = stack.pop() {
-        for e in std::fs::read_dir(&dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                if p != root.join("scene") && p != root.join("format") {
-                    stack.push(p);
-                }
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                let text = std::fs::read_to_string(&p).unwrap();
-                for (n, line) in text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with("//")) {
-                    // A texture's JSON and the raw material JSON of a primitive, too.
-                    let other = ["/textures/", "material_of("].iter().any(|l| line.contains(l));
-                    if other || json_keys(line).into_iter().any(is_material_key) {
-                        bad.push(format!("{}:{}: {}", p.display(), n + 1, line.trim()));
-                    }
-                }
-            }
-        }
-    }
+    let bad = stage_lines_where(|line| {
+        // A texture's JSON and the raw material JSON of a primitive, too.
+        let other = ["/textures/", "material_of("].iter().any(|l| line.contains(l));
+        other || json_keys(line).into_iter().any(is_material_key)
+    });
     assert!(bad.is_empty(), "material JSON read outside src/scene/ (ask Scene::materials):\n{}", bad.join("\n"));
 }
 

@@ -7,10 +7,10 @@ pub mod maps;
 use crate::error::{Error, Result};
 use crate::format::{self, WriteOptions, WriteStats};
 use crate::normalmap::Convention;
-use crate::report::Timings;
 use crate::scene::leave_out::Removal;
 use crate::scene::{ReadOptions, Scene};
-use crate::tangent::apply::{apply, ApplyOptions, PrimReport};
+use crate::tangent::apply::{apply, ApplyOptions, PrimTangents};
+use crate::timings::Timings;
 use maps::{ConventionCheck, HeightSettings};
 use std::path::PathBuf;
 
@@ -58,7 +58,7 @@ pub struct BakeReport {
     pub input: PathBuf,
     pub output: PathBuf,
     pub maps: Vec<MaterialMap>,
-    pub primitives: Vec<PrimReport>,
+    pub primitives: Vec<PrimTangents>,
     pub removed: Vec<Removal>,
     pub removed_bytes: usize,
     pub written: WriteStats,

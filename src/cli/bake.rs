@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
   bumpbake bake low.glb --from sculpt.glb -o low_baked.glb --size 2048 --samples 2 --miss-mask misses.png")]
 pub struct Args {
     #[command(flatten)]
-    pub io: super::report::MeshIo,
+    pub io: super::args::MeshIo,
     /// Height map to convert into the normal map (PNG, JPEG, WebP, TIFF or EXR).
     #[arg(long, conflicts_with_all = ["normal", "from"])]
     pub height: Option<PathBuf>,
@@ -106,7 +106,7 @@ pub struct Args {
     #[arg(long, value_parser = ["embed", "external"], default_value = "embed")]
     pub images: String,
     #[command(flatten)]
-    pub batch: super::report::BatchArgs,
+    pub batch: super::args::BatchArgs,
 }
 
 pub fn run(a: Args) -> Result<u8> {
@@ -151,7 +151,7 @@ pub fn run(a: Args) -> Result<u8> {
     };
     let opts = a.batch.options(a.io.inputs.len());
     let results = batch::run(&a.io.inputs, &opts, |input| {
-        run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
+        run_job(&job(input, super::args::paired(&a.io.inputs, &outputs, input)))
     })?;
     super::print::all(&a.io.inputs, results, a.batch.json, a.batch.quiet)
 }

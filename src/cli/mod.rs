@@ -3,6 +3,7 @@
 #[macro_use]
 mod out;
 
+mod args;
 mod bake;
 mod bench;
 mod completions;
@@ -11,7 +12,6 @@ mod normalmap;
 mod preview;
 mod print;
 mod progress;
-mod report;
 mod tangents;
 mod validate;
 

@@ -69,7 +69,7 @@ pub struct Args {
     #[arg(long, default_value_t = nm::DEFAULT_MAX_PIXELS)]
     pub max_pixels: u64,
     #[command(flatten)]
-    pub batch: super::report::BatchArgs,
+    pub batch: super::args::BatchArgs,
 }
 
 fn strength(args: &Args) -> Result<f32> {
@@ -99,7 +99,7 @@ fn strength(args: &Args) -> Result<f32> {
 pub struct Converted {
     pub input: PathBuf,
     pub output: PathBuf,
-    pub timings_ms: bumpbake::report::Timings,
+    pub timings_ms: bumpbake::timings::Timings,
     /// A map that came out (nearly) flat.
     pub warnings: Vec<String>,
     /// Whether this is one of several inputs (the text then names the files).
@@ -108,7 +108,7 @@ pub struct Converted {
 }
 
 pub fn run(args: Args) -> Result<u8> {
-    let outputs = super::report::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
+    let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
     let options = Options { strength: strength(&args)?, filter: args.filter, wrap: args.wrap, invert: args.invert };
     let convert = |input: &Path, output: &Path| -> Result<Convert> {
         let format = nm::OutputFormat::from_path(output)?;
@@ -136,8 +136,7 @@ pub fn run(args: Args) -> Result<u8> {
     } else {
         let opts = args.batch.options(args.heights.len());
         batch::run(&args.heights, &opts, |input| {
-            convert(input, super::report::paired(&args.heights, &outputs, input))
-                .and_then(|c| nm::convert_file(&c, None))
+            convert(input, super::args::paired(&args.heights, &outputs, input)).and_then(|c| nm::convert_file(&c, None))
         })?
     };
     let records: Vec<Result<Converted>> = results

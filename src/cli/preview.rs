@@ -5,7 +5,9 @@ use bumpbake::preview::compare::{compare, Comparison, DiffKind};
 use bumpbake::preview::{render, Camera, CameraSpec, Light, Options, Params, Prepared, View};
 use bumpbake::scene::{ReadOptions, Scene};
 use bumpbake::{Error, Result};
+use clap::builder::PossibleValue;
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 use std::time::Instant;
 
 /// Render an asset with the reference bump-mapping model (shaders/) on the CPU, or measure pipeline error.
@@ -74,16 +76,30 @@ pub struct Args {
     pub quiet: bool,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+/// What `--view` takes: every view the library renders, and `diff` for `--compare`. The values
+/// and their names are the library's `View`; this only adds `diff` and keeps clap out of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ViewArg {
-    Shaded,
-    Normal,
-    Tangent,
-    Bitangent,
-    Handedness,
-    Nomap,
+    Render(View),
     /// The difference between IN (or --reference) and --compare.
     Diff,
+}
+
+impl clap::ValueEnum for ViewArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        static ALL: LazyLock<Vec<ViewArg>> =
+            LazyLock::new(|| View::ALL.iter().map(|&v| ViewArg::Render(v)).chain([ViewArg::Diff]).collect());
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(match self {
+            ViewArg::Render(v) => PossibleValue::new(v.name()),
+            ViewArg::Diff => {
+                PossibleValue::new("diff").help("The difference between IN (or --reference) and --compare")
+            }
+        })
+    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -166,12 +182,9 @@ pub fn run(a: Args) -> Result<u8> {
     let lights =
         a.light.iter().map(|l| Light::parse(l)).collect::<std::result::Result<Vec<_>, _>>().map_err(Error::usage)?;
     let view = match a.view {
-        ViewArg::Shaded | ViewArg::Diff => View::Shaded,
-        ViewArg::Normal => View::Normal,
-        ViewArg::Tangent => View::Tangent,
-        ViewArg::Bitangent => View::Bitangent,
-        ViewArg::Handedness => View::Handedness,
-        ViewArg::Nomap => View::Nomap,
+        ViewArg::Render(v) => v,
+        // The difference of the shaded renders (or of their normals, by --diff).
+        ViewArg::Diff => View::Shaded,
     };
     let opts = Options {
         width: a.size.0,
@@ -194,7 +207,7 @@ pub fn run(a: Args) -> Result<u8> {
             }
             (None, None) => return Err(Error::usage("preview: --compare needs a reference (IN or --reference)")),
         };
-        if a.view != ViewArg::Shaded && a.view != ViewArg::Diff {
+        if !matches!(a.view, ViewArg::Render(View::Shaded) | ViewArg::Diff) {
             return Err(Error::usage("preview: --compare writes the difference image; --view must be shaded or diff"));
         }
         let r = read(reference, a.allow_outside)?;

@@ -16,7 +16,7 @@ use std::path::Path;
   bumpbake tangents assets/*.glb --out-dir build/ -j 4 --json > report.jsonl")]
 pub struct Args {
     #[command(flatten)]
-    pub io: super::report::MeshIo,
+    pub io: super::args::MeshIo,
     /// Put buffers and images inside a .gltf as data URIs.
     #[arg(long)]
     pub embed: bool,
@@ -33,7 +33,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "smooth")]
     pub normals: Normals,
     #[command(flatten)]
-    pub batch: super::report::BatchArgs,
+    pub batch: super::args::BatchArgs,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -65,7 +65,7 @@ pub fn run(a: Args) -> Result<u8> {
     };
     let opts = a.batch.options(a.io.inputs.len());
     let results = batch::run(&a.io.inputs, &opts, |input| {
-        run_job(&job(input, super::report::paired(&a.io.inputs, &outputs, input)))
+        run_job(&job(input, super::args::paired(&a.io.inputs, &outputs, input)))
     })?;
     super::print::all(&a.io.inputs, results, a.batch.json, a.batch.quiet)
 }

@@ -4,7 +4,7 @@
 use super::{encode_normals, height_from_image, Channel, Depth, EncodeOptions, HeightPlane, NormalData, NormalImage};
 use super::{Convention, NormalPlane, Options, Progress};
 use crate::error::{Error, Result};
-use crate::report::Timings;
+use crate::timings::Timings;
 use image::{DynamicImage, ExtendedColorType, ImageEncoder};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};

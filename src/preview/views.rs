@@ -32,6 +32,10 @@ pub const LEFT_HANDED: [f32; 3] = [0.95, 0.45, 0.10];
 pub const BACKGROUND: [f32; 3] = [0.12, 0.12, 0.13];
 
 impl View {
+    /// Every view, in the order `--help` lists them.
+    pub const ALL: [View; 6] =
+        [View::Shaded, View::Normal, View::Tangent, View::Bitangent, View::Handedness, View::Nomap];
+
     pub fn name(self) -> &'static str {
         match self {
             View::Shaded => "shaded",

@@ -21,9 +21,9 @@ pub struct ApplyOptions {
     pub frames: Options,
 }
 
-/// What happened to one primitive.
+/// What tangent generation did to one primitive, and why.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct PrimReport {
+pub struct PrimTangents {
     pub mesh: usize,
     pub primitive: usize,
     /// `generated`, `kept` (valid tangents already there) or `skipped`.
@@ -66,13 +66,13 @@ pub fn needs_tangents(view: &PrimView, all: bool) -> std::result::Result<(), Str
 }
 
 /// Gives every primitive that needs them MikkTSpace tangents; returns a report per primitive.
-pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimReport>> {
+pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimTangents>> {
     let mut reports = Vec::new();
     let mut work: Vec<(PrimRef, Geometry)> = Vec::new();
     let mats = scene.materials().clone();
     for view in views(scene, &mats) {
         let r = view.at;
-        let report = |action, reason: Option<String>, with_uvs: bool| PrimReport {
+        let report = |action, reason: Option<String>, with_uvs: bool| PrimTangents {
             mesh: r.mesh,
             primitive: r.primitive,
             action,

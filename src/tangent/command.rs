@@ -1,10 +1,10 @@
 //! The `tangents` job as a library call: read, generate, write, report.
 
-use super::apply::{apply, ApplyOptions, PrimReport};
+use super::apply::{apply, ApplyOptions, PrimTangents};
 use crate::error::Result;
 use crate::format::{self, WriteOptions, WriteStats};
-use crate::report::Timings;
 use crate::scene::{ReadOptions, Scene};
+use crate::timings::Timings;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, Default)]
@@ -23,7 +23,7 @@ pub struct TangentsJob {
 pub struct TangentsReport {
     pub input: PathBuf,
     pub output: PathBuf,
-    pub primitives: Vec<PrimReport>,
+    pub primitives: Vec<PrimTangents>,
     pub generated: usize,
     pub kept: usize,
     pub skipped: usize,
@@ -39,16 +39,16 @@ pub struct TangentsReport {
 pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     let mut t = Timings::default();
     let mut scene = t.time("read", || Scene::read(&job.input, &job.read))?;
-    crate::report::mem_mark("read");
+    crate::timings::mem_mark("read");
     let prims = t.time("tangents", || apply(&mut scene, &job.apply))?;
-    crate::report::mem_mark("tangents");
+    crate::timings::mem_mark("tangents");
     let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;
-    crate::report::mem_mark("encode");
+    crate::timings::mem_mark("encode");
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &scene.dependencies()));
     }
     t.time("write", || files.commit())?;
-    crate::report::mem_mark("write");
+    crate::timings::mem_mark("write");
     let mut notes = std::mem::take(&mut scene.notes);
     // `bake` converts these; `tangents` leaves them, and says so.
     for h in &scene.height_maps {
@@ -65,7 +65,7 @@ pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
 fn summarise(
     input: &Path,
     output: &Path,
-    prims: Vec<PrimReport>,
+    prims: Vec<PrimTangents>,
     notes: Vec<String>,
     written: WriteStats,
     t: Timings,

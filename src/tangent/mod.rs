@@ -77,7 +77,7 @@ pub fn with_frames(g: Geometry, opts: &Options) -> (Primitive, FrameStats) {
     let (plan, fallback) = split_plan(&g, opts);
     let mut out = plan.apply(g.primitive);
     out.mode = 4;
-    crate::report::mem_mark("split");
+    crate::timings::mem_mark("split");
     let stats = FrameStats { vertices_in, vertices_out: out.vertex_count(), triangles, generated_normals, fallback };
     (out, stats)
 }
@@ -121,11 +121,11 @@ fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
         }
     };
     drop((positions, uvs));
-    crate::report::mem_mark("engine");
+    crate::timings::mem_mark("engine");
     to_gltf_w(&mut frames);
     let fallback =
         fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
-    crate::report::mem_mark("repair");
+    crate::timings::mem_mark("repair");
 
     // Every corner has a frame now. Tangents and bitangents are read through the compact frames,
     // never spelt out per corner.

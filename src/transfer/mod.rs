@@ -21,15 +21,15 @@ use crate::error::{Error, Result};
 use crate::format::raw::RawMesh;
 use crate::normalmap::Convention;
 use crate::progress::Reporter;
-use crate::report::Timings;
 use crate::scene::{PrimRef, ReadOptions, Scene};
+use crate::timings::Timings;
 use glam::{Mat3A, Vec3A};
 use mesh::{High, Low, Placed};
 pub use parts::Match;
 use raster::{Edges, UvTri};
 use rayon::prelude::*;
 pub use report::{Counts, TransferReport};
-use report::{HighFile, HighPartReport, MaterialReport, Pair, PartStats};
+use report::{HighFile, HighPartReport, MaterialBake, Pair, PartStats};
 use std::path::PathBuf;
 
 /// Default ray reach on each side of LOW, as a fraction of LOW's bounding-box diagonal.
@@ -184,12 +184,12 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
     let (origin, diagonal) = mesh::frame(scene, &placed)?;
     let given = s.given.as_ref().and_then(|g| g.lock().ok().and_then(|mut m| m.take()));
     let (high, counts, high_parts) = t.time("read high", || mesh::high(&s.highs, &s.read, origin, given))?;
-    crate::report::mem_mark("transfer read");
+    crate::timings::mem_mark("transfer read");
     let high_names: Vec<String> = high_parts.iter().map(|p| p.name.clone()).collect();
     let groups = parts::group(&low_names, &high_names, s.matching);
     let High { positions, triangles, normals, normal_triangles } = high;
     let sets = t.time("bvh", || build_sets(positions, triangles, &high_parts, &groups.sets));
-    crate::report::mem_mark("transfer bvh");
+    crate::timings::mem_mark("transfer bvh");
     let high_bytes = sets.positions.capacity() * 12
         + sets.bvhs.iter().map(|b| b.bytes()).sum::<usize>()
         + sets.ids.iter().flatten().map(|v| v.capacity() * 4).sum::<usize>()
@@ -224,7 +224,7 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
             back,
         };
         let (texels, mut c, mut part_stats) = t.time("rays", || ctx.trace(s));
-        crate::report::mem_mark("transfer rays");
+        crate::timings::mem_mark("transfer rays");
         let (w, h) = (s.width, s.height);
         let mut n: Vec<[f32; 3]> = texels.iter().map(|x| x.normal).collect();
         let mut filled: Vec<bool> = texels.iter().map(|x| x.state > 0).collect();
@@ -242,7 +242,7 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
             st.triangles = low.tri_part.iter().filter(|&&p| p as usize == i).count();
         }
         let names = scene.materials();
-        mats.push(MaterialReport {
+        mats.push(MaterialBake {
             material: m,
             name: names.get(m).and_then(|x| x.name.clone()),
             files: extra.iter().map(|(p, _)| p.clone()).collect(),

@@ -1,7 +1,7 @@
 //! What a `bake --from` run did: for the whole run, per material (one map each) and per LOW
 //! part, with the parts paired by name and those left unmatched.
 
-use crate::report::Timings;
+use crate::timings::Timings;
 use std::path::PathBuf;
 
 /// Counts of what happened, per texel unless named otherwise.
@@ -96,9 +96,9 @@ impl PartStats {
     }
 }
 
-/// One material's map.
+/// What baking one material's map did.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct MaterialReport {
+pub struct MaterialBake {
     pub material: usize,
     pub name: Option<String>,
     /// The extra files written for it (`--map-out`, `--height-out`, `--miss-mask`).
@@ -133,6 +133,6 @@ pub struct TransferReport {
     pub unmatched_low: Vec<String>,
     pub unmatched_high: Vec<String>,
     pub high_parts: Vec<HighPartReport>,
-    pub materials: Vec<MaterialReport>,
+    pub materials: Vec<MaterialBake>,
     pub timings_ms: Timings,
 }

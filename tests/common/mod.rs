@@ -318,3 +318,30 @@ pub fn data_uri(mime: &str, bytes: &[u8]) -> String {
     use base64::Engine as _;
     format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(bytes))
 }
+
+/// Every line of code (comments left out) of the crate's sources outside `src/scene/` (the
+/// model) and `src/format/` (the readers that build it) for which `found` holds, as
+/// `path:line: text`: what guard tests use to keep a decision in the model.
+pub fn stage_lines_where(found: impl Fn(&str) -> bool) -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut out = Vec::new();
+    let mut stack = vec![root.clone()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                if p != root.join("scene") && p != root.join("format") {
+                    stack.push(p);
+                }
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let text = std::fs::read_to_string(&p).unwrap();
+                for (n, line) in text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with("//")) {
+                    if found(line) {
+                        out.push(format!("{}:{}: {}", p.display(), n + 1, line.trim()));
+                    }
+                }
+            }
+        }
+    }
+    out
+}

@@ -76,11 +76,11 @@ pub enum Unsupported {
 /// of corners the reference summed together; no frame where the reference gives no answer. One
 /// slot per index (a trailing partial triangle gets none, as with the reference wrapper).
 pub fn generate(mesh: &TriMesh) -> Result<Frames, Unsupported> {
-    generate_timed(mesh, &mut crate::report::Timings::default())
+    generate_timed(mesh, &mut crate::timings::Timings::default())
 }
 
 /// [`generate`], recording the wall time of each stage in `timings`.
-pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::report::Timings) -> Result<Frames, Unsupported> {
+pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::timings::Timings) -> Result<Frames, Unsupported> {
     let n_faces = mesh.indices.len() / 3;
     if n_faces.checked_mul(3).is_none_or(|n| n >= (u32::MAX as usize) - 4) {
         return Err(Unsupported::TooLarge);
@@ -174,13 +174,13 @@ fn finish<W: Welded>(
     mut orient: Vec<bool>,
     order: &Order,
     ng: usize,
-    timings: &mut crate::report::Timings,
+    timings: &mut crate::timings::Timings,
 ) -> Frames {
     let n_faces = order.len();
     let nb = timings.time("neighbors", || neighbors::build(&w, 3 * ng, 3 * n_faces, short_tail));
-    crate::report::mem_mark("engine neighbors");
+    crate::timings::mem_mark("engine neighbors");
     let mut grp = timings.time("groups", || groups::build(&w, &nb, &gwa, &mut orient));
-    crate::report::mem_mark("engine groups");
+    crate::timings::mem_mark("engine groups");
     drop((nb, orient));
     // Sums are made a slice of groups at a time and kept compactly: one value for a group whose
     // members all got the same bits (the usual case), else one per member.
@@ -208,7 +208,7 @@ fn finish<W: Welded>(
     }
     first_slot.push(values.len() as u32);
     timings.stages.push(("accumulate".into(), t_acc.elapsed().as_secs_f64() * 1e3));
-    crate::report::mem_mark("engine accumulate");
+    crate::timings::mem_mark("engine accumulate");
     let t_out = std::time::Instant::now();
     // Only what the scatter below needs stays: the welded ids only for degenerate triangles.
     drop(gwa);

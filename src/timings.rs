@@ -1,4 +1,4 @@
-//! Timing of pipeline stages, shared by every command's report.
+//! Timing of pipeline stages (each command's report carries its `Timings`), and memory marks.
 
 use std::time::Instant;
 

@@ -1,0 +1,18 @@
+//! A renderer's view of a primitive (`scene::view`) is the only place the stages learn what a
+//! renderer makes of a primitive: its mode, its values as floats, the node tree that places it.
+
+mod common;
+
+/// No stage outside `src/scene/` (the model) and `src/format/` (the readers that build it) reads
+/// a primitive's `mode`, dequantizes, or walks the node tree itself: they ask `PrimView`,
+/// `Geometry` and `nodes::instances`.
+#[test]
+fn only_the_scene_model_reads_mode_dequantizes_or_walks_nodes() {
+    let lookups = ["\"mode\"", "dequant::", "\"children\"", "local_matrix("];
+    let bad = common::stage_lines_where(|line| lookups.iter().any(|l| line.contains(l)));
+    assert!(
+        bad.is_empty(),
+        "outside src/scene/ and src/format/ (use scene::view and scene::nodes):\n{}",
+        bad.join("\n")
+    );
+}
