@@ -352,13 +352,14 @@ pub fn table(rows: &[LargeRow]) -> String {
     );
     for r in rows {
         s += &format!(
-            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>6.2} {:>8.0} {:>10.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}  {}\n",
+            "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>6} {:>8.0} {:>10.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}  {}\n",
             r.high_triangles,
             format!("{:?}", r.source).to_lowercase(),
             r.file_mb,
             r.size,
             r.wall_s,
-            r.cpu_s,
+            // Unknown with --blender: the children's CPU time includes Blender's.
+            if r.cpu_s.is_finite() { format!("{:.2}", r.cpu_s) } else { "-".into() },
             r.read_high_ms,
             r.read_mb_s,
             r.bvh_ms,
