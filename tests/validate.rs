@@ -5,7 +5,7 @@
 mod common;
 mod validate_support;
 use common::*;
-use serde_json::json;
+use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use validate_support::*;
 
@@ -287,17 +287,23 @@ fn sliver_triangle_is_info() {
     assert_eq!(code, 0);
 }
 
+/// The primitive JSON of a grid whose material reads a bumpy normal map, its data added to `g`.
+fn mapped_grid(g: &mut Gltf) -> Value {
+    let p = grid_prim();
+    let attrs = attrs_of(g, &p);
+    let i = g.indices(&p.idx);
+    let tex = texture_of(g, &bumpy(false));
+    let m = g.material(json!({ "normalTexture": { "index": tex } }));
+    json!({ "attributes": attrs, "indices": i, "material": m })
+}
+
 #[test]
 fn mirrored_instance_is_info() {
     let d = scratch_dir("validate_node_mirror");
     // The mesh's node sits under a parent with a negative scale.
     let mut g = Gltf::new();
-    let p = grid_prim();
-    let attrs = attrs_of(&mut g, &p);
-    let i = g.indices(&p.idx);
-    let tex = texture_of(&mut g, &bumpy(false));
-    let m = g.material(json!({ "normalTexture": { "index": tex } }));
-    g.mesh(json!({ "attributes": attrs, "indices": i, "material": m }));
+    let mesh = mapped_grid(&mut g);
+    g.mesh(mesh);
     g.json["nodes"]
         .as_array_mut()
         .unwrap()
@@ -318,12 +324,9 @@ fn mirrored_instance_is_info() {
 fn mirror_check_walks_the_default_scene() {
     let d = scratch_dir("validate_node_mirror_scenes");
     let mut g = Gltf::new();
-    let p = grid_prim();
-    let attrs = attrs_of(&mut g, &p);
-    let i = g.indices(&p.idx);
-    let tex = texture_of(&mut g, &bumpy(false));
-    let m = g.material(json!({ "normalTexture": { "index": tex } }));
-    g.mesh(json!({ "attributes": attrs, "indices": i, "material": m, "name": "quad" }));
+    let mut mesh = mapped_grid(&mut g);
+    mesh["name"] = json!("quad");
+    g.mesh(mesh);
     let nodes = g.json["nodes"].as_array_mut().unwrap();
     nodes.push(json!({ "name": "mirror", "scale": [-1.0, 1.0, 1.0], "children": [0] }));
     nodes.push(json!({ "name": "other scene", "scale": [1.0, 1.0, -1.0], "mesh": 0 }));
