@@ -60,12 +60,19 @@ pub struct ObjData {
 pub fn parse_file(path: &Path, progress: &Reporter) -> Result<ObjData> {
     let file = std::fs::File::open(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
     let len = file.metadata().map_or(0, |m| m.len());
-    reported(path, len, progress, |p| parse_reader(path, Counting::new(file, p), PIECE))
+    reported(path, len, progress, |p| parse_reader(path, Counting::new(file, p), piece_for(len)))
+}
+
+/// Pieces for a file of `len` bytes: [`PIECE`], or smaller for a file under a block, so that a
+/// small file's buffer is its own size and not a whole block's (zeroed before the read fills it).
+fn piece_for(len: u64) -> usize {
+    PIECE.min(usize::try_from(len).unwrap_or(usize::MAX) / PIECES_PER_BLOCK + 4096)
 }
 
 /// Parses OBJ bytes already in memory, reported as [`parse_file`] reports a file.
 pub fn parse_bytes(path: &Path, bytes: &[u8], progress: &Reporter) -> Result<ObjData> {
-    reported(path, bytes.len() as u64, progress, |p| parse_reader(path, Counting::new(bytes, p), PIECE))
+    let piece = piece_for(bytes.len() as u64);
+    reported(path, bytes.len() as u64, progress, |p| parse_reader(path, Counting::new(bytes, p), piece))
 }
 
 fn reported(
