@@ -92,8 +92,7 @@ impl Blender {
 impl Runs {
     /// The row, its ratio taken against bumpbake's median `ours_s`.
     pub fn row(mut self, ours_s: f64) -> BlenderRow {
-        let (min_s, max_s) =
-            (self.wall.iter().cloned().fold(f64::INFINITY, f64::min), self.wall.iter().cloned().fold(0.0, f64::max));
+        let (min_s, max_s) = super::spread(&self.wall);
         let median_s = super::median(&mut self.wall);
         BlenderRow {
             version: self.version,

@@ -18,6 +18,11 @@ pub(crate) fn fingerprint(bytes: &[u8]) -> String {
     format!("{h:016x}")
 }
 
+/// The smallest and largest of `v` ((inf, 0) when empty: times are never negative).
+pub(crate) fn spread(v: &[f64]) -> (f64, f64) {
+    (v.iter().copied().fold(f64::INFINITY, f64::min), v.iter().copied().fold(0.0, f64::max))
+}
+
 /// The median of `v` (sorted in place), the mean of the middle two for an even count; 0 when empty.
 pub(crate) fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);

@@ -455,8 +455,7 @@ pub(crate) fn time_one(
     let error = evaluate(&out, &|p, d| torus.truth(p, d, reach), &|_| true)?;
     let out_fingerprint = std::fs::read(&out).map(|b| super::fingerprint(&b)).unwrap_or_default();
     let _ = std::fs::remove_file(&out);
-    let (min_s, max_s) =
-        (times.iter().cloned().fold(f64::INFINITY, f64::min), times.iter().cloned().fold(0.0, f64::max));
+    let (min_s, max_s) = super::spread(&times);
     let [mut a, mut b, mut c] = stages;
     let median_s = super::median(&mut times);
     Ok(Row {

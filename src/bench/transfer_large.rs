@@ -23,13 +23,17 @@ pub enum Source {
 }
 
 impl Source {
-    pub fn parse(s: &str) -> Option<Source> {
-        match s.trim() {
-            "memory" => Some(Source::Memory),
-            "obj" => Some(Source::Obj),
-            "ply" => Some(Source::Ply),
-            _ => None,
+    /// As `--large-from` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Memory => "memory",
+            Source::Obj => "obj",
+            Source::Ply => "ply",
         }
+    }
+
+    pub fn parse(s: &str) -> Option<Source> {
+        [Source::Memory, Source::Obj, Source::Ply].into_iter().find(|x| x.name() == s.trim())
     }
 }
 
@@ -247,7 +251,7 @@ pub fn time_reader(path: &Path, runs: usize) -> Result<ReadTiming> {
         drop(m);
     }
     let mb = std::fs::metadata(path).map_or(0.0, |m| m.len() as f64 / 1e6);
-    let min_ms = times.iter().cloned().fold(f64::INFINITY, f64::min);
+    let min_ms = super::spread(&times).0;
     let median_ms = super::median(&mut times);
     Ok(ReadTiming {
         runs: times.len(),
@@ -354,7 +358,7 @@ pub fn table(rows: &[LargeRow]) -> String {
         s += &format!(
             "{:>9}  {:<7} {:>8.0} {:>5} {:>7.2} {:>6} {:>8.0} {:>10.0} {:>7.0} {:>8.0} {:>8.0} {:>6.0} {:>13.0} {:>6.3} {:>5.3}  {}\n",
             r.high_triangles,
-            format!("{:?}", r.source).to_lowercase(),
+            r.source.name(),
             r.file_mb,
             r.size,
             r.wall_s,
@@ -377,7 +381,7 @@ pub fn table(rows: &[LargeRow]) -> String {
             s += &format!(
                 "Blender {} on the same {} ({} triangles), {} runs: median {:.2} s ({:.2}-{:.2}; import {:.2} s, bake {:.2} s), peak {:.0} MB: bumpbake {:.1}x faster, {:.1}x less memory\n",
                 b.version,
-                format!("{:?}", r.source).to_uppercase(),
+                r.source.name().to_uppercase(),
                 r.high_triangles,
                 b.runs,
                 b.median_s,
@@ -400,7 +404,7 @@ pub fn table(rows: &[LargeRow]) -> String {
             s += &format!(
                 "{:>9}  {:<7} {:>8.0} {:>5} {:>10.0} {:>7.0} {:>6.0} {:>7.0}\n",
                 r.high_triangles,
-                format!("{:?}", r.source).to_lowercase(),
+                r.source.name(),
                 r.file_mb,
                 t.runs,
                 t.median_ms,
