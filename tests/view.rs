@@ -16,3 +16,22 @@ fn only_the_scene_model_reads_mode_dequantizes_or_walks_nodes() {
         bad.join("\n")
     );
 }
+
+/// OBJ and PLY UVs are turned to glTF's orientation once, at load: no flag travels with a
+/// primitive for stages to branch on, in any module.
+#[test]
+fn no_stage_branches_on_the_source_uv_orientation() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut stack = vec![src];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let text = std::fs::read_to_string(&p).unwrap();
+                assert!(!text.contains("uv_v_up"), "{} names uv_v_up", p.display());
+            }
+        }
+    }
+}
