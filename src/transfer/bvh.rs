@@ -34,6 +34,8 @@ pub struct Bvh {
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
+/// A node visit costed in triangle tests, for the leaf-or-split choice.
+const NODE_COST: f32 = 2.0;
 /// Ranges of at most this many triangles are split exactly, without bins ([`build_small`]).
 const SMALL: usize = 16;
 /// Ranges smaller than this are built on the current thread.
@@ -42,7 +44,7 @@ const PARALLEL_MIN: usize = 16 * 1024;
 /// pass over every item per level) and binned SAH builds only ranges of [`SAH_RANGE`] or fewer,
 /// whose items fit in a core's cache.
 const MORTON_MIN: usize = 64 * 1024;
-const SAH_RANGE: usize = 1024;
+const SAH_RANGE: usize = 256;
 /// A Morton key holds the code above a triangle's index, so keys are unique and sort alike on
 /// any thread count: 12 bits an axis over 28 bits of index (HIGHs up to 268M triangles).
 const INDEX_BITS: u32 = 28;
@@ -98,35 +100,37 @@ impl Bvh {
     /// and their ids stay aligned with the input.
     pub fn build(positions: &[[f32; 3]], triangles: Vec<[u32; 3]>) -> Bvh {
         use rayon::prelude::*;
-        let item = |i: usize| {
-            let mut b = Aabb::EMPTY;
-            triangles[i].iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
-            Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
-        };
         let n = triangles.len();
         if n == 0 {
             return Bvh { nodes: Vec::new(), tris: Vec::new(), ids: Vec::new(), corners: Vec::new() };
         }
-        let (mut items, nodes): (Vec<Item>, Vec<Node>);
-        if (MORTON_MIN..1 << INDEX_BITS).contains(&n) {
-            let mut keys = morton_keys(n, item);
-            items = keys.par_iter().map(|k| item((k & INDEX_MASK) as usize)).collect();
+        let mut items: Vec<Item> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let mut b = Aabb::EMPTY;
+                triangles[i].iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
+                Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
+            })
+            .collect();
+        let bc = bounds_of(&items);
+        let nodes = if (MORTON_MIN..1 << INDEX_BITS).contains(&n) {
+            let mut keys = morton_keys(&items, &bc.1);
+            items = keys.par_iter().map(|k| items[(k & INDEX_MASK) as usize]).collect();
             keys.iter_mut().for_each(|k| *k >>= INDEX_BITS);
-            let top = build_morton(&mut items, &keys, 0);
-            drop(keys);
-            nodes = top.assemble();
+            build_morton(&mut items, &keys, 0).assemble()
         } else {
-            items = (0..n).into_par_iter().map(item).collect();
-            let bc = bounds_of(&items);
-            nodes = build_par(&mut items, 0, bc);
-        }
-        let nodes = collapse(&nodes);
+            build_par(&mut items, 0, bc)
+        };
+        // Each array is dropped as soon as the next is made from it: the build's peak is what
+        // bounds memory on a large HIGH.
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         drop(items);
+        let wide = collapse(&nodes);
+        drop(nodes);
         let tris: Vec<[u32; 3]> = ids.par_iter().map(|&i| triangles[i as usize]).collect();
         drop(triangles);
         let corners = tris.par_iter().map(|t| t.map(|i| positions[i as usize])).collect();
-        Bvh { nodes, tris, ids, corners }
+        Bvh { nodes: wide, tris, ids, corners }
     }
 
     /// An empty tree has no nodes.
@@ -268,7 +272,7 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
     // A node visit is costed as two triangle tests: on the benchmark's HIGH that gives 36% fewer
     // nodes and took about 6% less CPU than costing it as one (same map, bit for bit).
     let leaf_cost = b.area() * items.len() as f32;
-    if items.len() <= MAX_LEAF && cost + 2.0 * b.area() >= leaf_cost {
+    if items.len() <= MAX_LEAF && cost + NODE_COST * b.area() >= leaf_cost {
         return None;
     }
     Some(Split { axis, k, left: bins_bounds(&bins, 0..k), right: bins_bounds(&bins, k..BINS) })
@@ -302,31 +306,19 @@ fn halves(items: &[Item]) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
     (mid, bounds_of(&items[..mid]), bounds_of(&items[mid..]))
 }
 
-/// Each triangle's key (Morton code of its box's centre over the centres' bounds, then its
+/// Each item's key (Morton code of its box's centre over the centres' bounds `c`, then its
 /// index), sorted: three stable passes of 12 bits over the code, from index order.
-fn morton_keys(n: usize, item: impl Fn(usize) -> Item + Sync) -> Vec<u64> {
+fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
     use rayon::prelude::*;
-    let centres = |r: std::ops::Range<usize>| {
-        let mut c = Aabb::EMPTY;
-        r.for_each(|i| c.grow(item(i).centre()));
-        c
-    };
-    let chunks: Vec<std::ops::Range<usize>> =
-        (0..n).step_by(PARALLEL_MIN).map(|a| a..(a + PARALLEL_MIN).min(n)).collect();
-    let c = chunks.par_iter().map(|r| centres(r.clone())).reduce(
-        || Aabb::EMPTY,
-        |mut a, b| {
-            a.join(&b);
-            a
-        },
-    );
+    let n = items.len();
     let cells = (1u32 << AXIS_BITS) as f32;
     let extent = c.max - c.min;
     let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
-    let mut keys: Vec<u64> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let q = ((item(i).centre() - c.min) * scale).min(Vec3A::splat(cells - 1.0));
+    let mut keys: Vec<u64> = items
+        .par_iter()
+        .enumerate()
+        .map(|(i, it)| {
+            let q = ((it.centre() - c.min) * scale).min(Vec3A::splat(cells - 1.0));
             let code = spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2;
             code << INDEX_BITS | i as u64
         })
@@ -506,7 +498,7 @@ fn build_small(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, b: Aabb
     }
     let (cost, k, lb) = best;
     // As in `split`: a node visit costs two triangle tests.
-    if n <= MAX_LEAF && cost + 2.0 * b.area() >= b.area() * n as f32 {
+    if n <= MAX_LEAF && cost + NODE_COST * b.area() >= b.area() * n as f32 {
         nodes.push(leaf(&b, offset, n));
         return;
     }
