@@ -161,15 +161,46 @@ fn any_piece_size_gives_the_same_result() {
     let whole = parse(&s);
     assert!(whole.tri_v.len() > 60);
     for piece in [1, 2, 3, 5, 7, 16, 64, 1000] {
-        let d = parse_reader(Path::new("t.obj"), s.as_bytes(), piece).unwrap();
-        assert_eq!(d, whole, "piece {piece}");
+        assert_eq!(pieces(&s, piece).unwrap(), whole, "piece {piece}");
     }
-    // Errors keep their line numbers too.
-    let bad = format!("{s}f 1 2 999\n");
-    let lines = bad.lines().count();
-    for piece in [1, 3, 64, 1 << 20] {
-        let e = parse_reader(Path::new("t.obj"), bad.as_bytes(), piece).unwrap_err().to_string();
-        assert!(e.contains(&format!("line {lines}:")), "{e}");
+    // Errors keep their line numbers too: one at the end, a relative index reaching before the
+    // first in the middle, and one past the file's end in a face before the last `v`.
+    let lines = s.lines().count();
+    let bad = [
+        (format!("{s}f 1 2 999\n"), lines + 1),
+        (format!("v 0 0 0\n{s}f 1 -999 2\n{s}"), lines + 2),
+        (format!("{s}f 1 2 999\n{s}"), lines + 1),
+    ];
+    for (bad, line) in &bad {
+        for piece in [1, 3, 64, 1 << 20] {
+            let e = pieces(bad, piece).unwrap_err();
+            assert!(e.contains(&format!("line {line}:")), "{e}");
+        }
+    }
+}
+
+/// `s` parsed with pieces of about `piece` bytes, both from memory and through a reader.
+fn pieces(s: &str, piece: usize) -> std::result::Result<ObjData, String> {
+    let path = Path::new("t.obj");
+    let mapped = parse_pieces::<true>(path, s.as_bytes(), piece, &Reporter::none()).map_err(|e| e.to_string());
+    let read = parse_reader(path, s.as_bytes(), piece).map_err(|e| e.to_string());
+    assert_eq!(mapped, read, "piece {piece}");
+    mapped
+}
+
+/// Pieces that need what comes before them (relative indices, faces naming vertices further
+/// down) read as the whole file does, for every piece size.
+#[test]
+fn pieces_that_need_their_base_read_as_the_whole() {
+    let mut s = String::from("f 3 2 1\n");
+    for i in 0..30 {
+        s += &format!("v {i} 0 0\nvn 0 0 1\nvt {i} 1\n");
+        s += if i % 4 == 3 { "f 1/1/1 -1/-1/-1 -2/-2/-2\n" } else { "f 1 2 3 4 5 6 7\n" };
+    }
+    let whole = parse(&s);
+    assert_eq!(whole.tri_v[0], [2, 1, 0]);
+    for piece in [1, 4, 9, 30, 200] {
+        assert_eq!(pieces(&s, piece).unwrap(), whole, "piece {piece}");
     }
 }
 
@@ -235,8 +266,9 @@ fn fast_path_reads_as_the_general_path() {
         }
         // Pieces of 7 bytes cut lines everywhere; 4096 holds each file whole.
         for piece in [7, 1 << 12] {
-            let fast = parse_with::<true>(Path::new("t.obj"), s.as_bytes(), piece).map_err(|e| e.to_string());
-            let slow = parse_with::<false>(Path::new("t.obj"), s.as_bytes(), piece).map_err(|e| e.to_string());
+            let none = Reporter::none();
+            let fast = parse_pieces::<true>(Path::new("t.obj"), s.as_bytes(), piece, &none).map_err(|e| e.to_string());
+            let slow = parse_pieces::<false>(Path::new("t.obj"), s.as_bytes(), piece, &none).map_err(|e| e.to_string());
             assert_eq!(fast, slow, "file {file}, piece {piece}:\n{s}");
         }
     }
