@@ -553,8 +553,17 @@ impl Piece {
     /// A polygon's triangles, fanned from its first corner (at least three corners).
     #[inline]
     fn fan(&mut self, corners: &[Corner]) {
-        let has_t = corners.iter().any(|c| c[1] != MISSING);
-        let has_n = corners.iter().any(|c| c[2] != MISSING);
+        // The face's largest index of each kind, plus one: 0 when no corner names that kind.
+        let mut top = [0u32; 3];
+        for c in corners {
+            for (m, x) in top.iter_mut().zip(c) {
+                *m = (*m).max(x.wrapping_add(1));
+            }
+        }
+        for (m, x) in self.max.iter_mut().zip(top) {
+            *m = (*m).max(x);
+        }
+        let (has_t, has_n) = (top[1] > 0, top[2] > 0);
         if has_t && !self.any_t {
             self.any_t = true;
             self.tt.resize(self.tv.len(), [MISSING; 3]);
@@ -562,11 +571,6 @@ impl Piece {
         if has_n && !self.any_n {
             self.any_n = true;
             self.tn.resize(self.tv.len(), [MISSING; 3]);
-        }
-        for c in corners {
-            for (m, x) in self.max.iter_mut().zip(c) {
-                *m = (*m).max(x.wrapping_add(1));
-            }
         }
         let a = corners[0];
         for w in corners[1..].windows(2) {

@@ -130,6 +130,11 @@ fn floats_are_exactly_what_str_parse_gives() {
         let want = t.parse::<f32>().ok();
         let got = parse_f32(t.as_bytes());
         assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "{t}");
+        for end in [" 0000000000\n", "\r\nv 1 2 3\n", "x1234567890"] {
+            let line = format!("{t}{end}");
+            let want = if end.starts_with('x') { None } else { want.map(|w| (w.to_bits(), t.len())) };
+            assert_eq!(lead_f32(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want, "{line}");
+        }
     }
     // Every f32 midpoint neighbourhood and random decimals of every length.
     let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
@@ -141,7 +146,11 @@ fn floats_are_exactly_what_str_parse_gives() {
         let mid = (f as f64 + f32::from_bits(f.to_bits() + 1) as f64) / 2.0;
         let digits = (x >> 40) as usize % 12 + 1;
         for t in [format!("{f}"), format!("{mid:e}"), format!("{:.*e}", digits, mid), format!("{:.*}", digits, f)] {
-            assert_eq!(parse_f32(t.as_bytes()).map(f32::to_bits), t.parse::<f32>().ok().map(f32::to_bits), "{t}");
+            let want = t.parse::<f32>().ok().map(f32::to_bits);
+            assert_eq!(parse_f32(t.as_bytes()).map(f32::to_bits), want, "{t}");
+            // Followed by more of the line, the digits are read eight at a time.
+            let line = format!("{t} 12345678 9\n");
+            assert_eq!(lead_f32(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want.map(|w| (w, t.len())), "{t}");
         }
     }
 }
