@@ -2,9 +2,11 @@
 //!
 //! The tree depends on the triangles only, never on the thread count: every split is decided by
 //! the same binned sweep, and subtrees built on other threads are spliced in a fixed order.
-//! HIGH is held once, indexed: the tree holds its triangles' corner indices (into positions that
-//! several trees can share), permuted into leaf order so that a leaf's triangles sit together.
+//! The tree holds its triangles' corners and corner indices (into normals that several trees can
+//! share) permuted into leaf order, so that a leaf's triangles sit together; HIGH's positions
+//! are needed only while it is built.
 
+use super::wide::{collapse, Wide};
 use glam::Vec3A;
 
 /// One node: 32 bytes. An inner node's left child is the next node and `a` is its right child;
@@ -19,17 +21,33 @@ pub struct Node {
 
 #[derive(Debug, Clone)]
 pub struct Bvh {
-    pub nodes: Vec<Node>,
+    /// The binary tree collapsed to four children a node, as the rays walk it.
+    pub nodes: Vec<Wide>,
     /// Corner indices into `positions`, in leaf order.
     pub tris: Vec<[u32; 3]>,
     /// Each leaf-order triangle's index in the input.
     pub ids: Vec<u32>,
+    /// Each leaf-order triangle's corners: a leaf's triangles are read from one place, not
+    /// through their indices from positions scattered over the whole mesh.
+    corners: Vec<[[f32; 3]; 3]>,
 }
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
+/// Ranges of at most this many triangles are split exactly, without bins ([`build_small`]).
+const SMALL: usize = 16;
 /// Ranges smaller than this are built on the current thread.
 const PARALLEL_MIN: usize = 16 * 1024;
+/// From this many triangles on, the upper levels split at Morton-code boundaries (one sort, no
+/// pass over every item per level) and binned SAH builds only ranges of [`SAH_RANGE`] or fewer,
+/// whose items fit in a core's cache.
+const MORTON_MIN: usize = 64 * 1024;
+const SAH_RANGE: usize = 1024;
+/// A Morton key holds the code above a triangle's index, so keys are unique and sort alike on
+/// any thread count: 12 bits an axis over 28 bits of index (HIGHs up to 268M triangles).
+const INDEX_BITS: u32 = 28;
+const INDEX_MASK: u64 = (1 << INDEX_BITS) - 1;
+const AXIS_BITS: u32 = 12;
 
 #[derive(Clone, Copy)]
 struct Aabb {
@@ -80,41 +98,54 @@ impl Bvh {
     /// and their ids stay aligned with the input.
     pub fn build(positions: &[[f32; 3]], triangles: Vec<[u32; 3]>) -> Bvh {
         use rayon::prelude::*;
-        let mut items: Vec<Item> = triangles
-            .par_iter()
-            .enumerate()
-            .map(|(i, t)| {
-                let mut b = Aabb::EMPTY;
-                t.iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
-                Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
-            })
-            .collect();
-        let nodes = if items.is_empty() {
-            vec![Node { min: [0.0; 3], a: 0, max: [0.0; 3], n: 0 }]
-        } else {
-            let bc = bounds_of(&items);
-            build_par(&mut items, 0, bc)
+        let item = |i: usize| {
+            let mut b = Aabb::EMPTY;
+            triangles[i].iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
+            Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
         };
+        let n = triangles.len();
+        if n == 0 {
+            return Bvh { nodes: Vec::new(), tris: Vec::new(), ids: Vec::new(), corners: Vec::new() };
+        }
+        let (mut items, nodes): (Vec<Item>, Vec<Node>);
+        if (MORTON_MIN..1 << INDEX_BITS).contains(&n) {
+            let mut keys = morton_keys(n, item);
+            items = keys.par_iter().map(|k| item((k & INDEX_MASK) as usize)).collect();
+            keys.iter_mut().for_each(|k| *k >>= INDEX_BITS);
+            let top = build_morton(&mut items, &keys, 0);
+            drop(keys);
+            nodes = top.assemble();
+        } else {
+            items = (0..n).into_par_iter().map(item).collect();
+            let bc = bounds_of(&items);
+            nodes = build_par(&mut items, 0, bc);
+        }
+        let nodes = collapse(&nodes);
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         drop(items);
-        let tris = ids.par_iter().map(|&i| triangles[i as usize]).collect();
-        Bvh { nodes, tris, ids }
+        let tris: Vec<[u32; 3]> = ids.par_iter().map(|&i| triangles[i as usize]).collect();
+        drop(triangles);
+        let corners = tris.par_iter().map(|t| t.map(|i| positions[i as usize])).collect();
+        Bvh { nodes, tris, ids, corners }
     }
 
-    /// An empty tree has a root with no triangles.
+    /// An empty tree has no nodes.
     pub fn is_empty(&self) -> bool {
         self.tris.is_empty()
     }
 
     /// The corners of leaf-order triangle `k`.
     #[inline]
-    pub fn corners(&self, positions: &[[f32; 3]], k: usize) -> [Vec3A; 3] {
-        self.tris[k].map(|i| Vec3A::from(positions[i as usize]))
+    pub fn corners(&self, k: usize) -> [Vec3A; 3] {
+        self.corners[k].map(Vec3A::from)
     }
 
     /// Bytes held, for the memory figures.
     pub fn bytes(&self) -> usize {
-        self.nodes.capacity() * std::mem::size_of::<Node>() + self.tris.capacity() * 12 + self.ids.capacity() * 4
+        self.nodes.capacity() * std::mem::size_of::<Wide>()
+            + self.tris.capacity() * 12
+            + self.ids.capacity() * 4
+            + self.corners.capacity() * 36
     }
 }
 
@@ -206,13 +237,7 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
     let extent = c.max - c.min;
     // One axis only: a third of the binning work of trying all three; on the benchmark's HIGH
     // the whole bake took less CPU time this way (build cheaper, tracing no slower).
-    let axis = if extent.x >= extent.y && extent.x >= extent.z {
-        0
-    } else if extent.y >= extent.z {
-        1
-    } else {
-        2
-    };
+    let axis = longest(extent);
     let e = extent[axis];
     if e.is_nan() || e <= 0.0 {
         return None;
@@ -277,6 +302,126 @@ fn halves(items: &[Item]) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
     (mid, bounds_of(&items[..mid]), bounds_of(&items[mid..]))
 }
 
+/// Each triangle's key (Morton code of its box's centre over the centres' bounds, then its
+/// index), sorted: three stable passes of 12 bits over the code, from index order.
+fn morton_keys(n: usize, item: impl Fn(usize) -> Item + Sync) -> Vec<u64> {
+    use rayon::prelude::*;
+    let centres = |r: std::ops::Range<usize>| {
+        let mut c = Aabb::EMPTY;
+        r.for_each(|i| c.grow(item(i).centre()));
+        c
+    };
+    let chunks: Vec<std::ops::Range<usize>> =
+        (0..n).step_by(PARALLEL_MIN).map(|a| a..(a + PARALLEL_MIN).min(n)).collect();
+    let c = chunks.par_iter().map(|r| centres(r.clone())).reduce(
+        || Aabb::EMPTY,
+        |mut a, b| {
+            a.join(&b);
+            a
+        },
+    );
+    let cells = (1u32 << AXIS_BITS) as f32;
+    let extent = c.max - c.min;
+    let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
+    let mut keys: Vec<u64> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let q = ((item(i).centre() - c.min) * scale).min(Vec3A::splat(cells - 1.0));
+            let code = spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2;
+            code << INDEX_BITS | i as u64
+        })
+        .collect();
+    let mut other = vec![0u64; n];
+    for pass in 0..3 {
+        let shift = INDEX_BITS + pass * AXIS_BITS;
+        let digit = |k: u64| ((k >> shift) as usize) & ((1 << AXIS_BITS) - 1);
+        let mut start = vec![0usize; 1 << AXIS_BITS];
+        keys.iter().for_each(|&k| start[digit(k)] += 1);
+        let mut sum = 0;
+        for s in start.iter_mut() {
+            (*s, sum) = (sum, sum + *s);
+        }
+        for &k in &keys {
+            let d = digit(k);
+            other[start[d]] = k;
+            start[d] += 1;
+        }
+        std::mem::swap(&mut keys, &mut other);
+    }
+    keys
+}
+
+/// The low 12 bits of `x`, two zero bits after each.
+fn spread(x: u64) -> u64 {
+    let mut x = x & 0xfff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+/// The upper levels over Morton-sorted items: each split where the codes' highest differing
+/// bit flips; ranges of [`SAH_RANGE`] or fewer (or of one code) are built by binned SAH.
+enum Top {
+    Range(Vec<Node>),
+    Split(Aabb, Box<Top>, Box<Top>),
+}
+
+impl Top {
+    fn bounds(&self) -> Aabb {
+        match self {
+            Top::Range(nodes) => Aabb { min: Vec3A::from(nodes[0].min), max: Vec3A::from(nodes[0].max) },
+            Top::Split(b, ..) => *b,
+        }
+    }
+
+    fn len(&self) -> usize {
+        match self {
+            Top::Range(nodes) => nodes.len(),
+            Top::Split(_, l, r) => 1 + l.len() + r.len(),
+        }
+    }
+
+    /// The binary tree in one array, in the order [`build_par`] lays it out.
+    fn assemble(self) -> Vec<Node> {
+        fn put(t: Top, out: &mut Vec<Node>) {
+            match t {
+                Top::Range(nodes) => {
+                    let base = out.len() as u32;
+                    out.extend(nodes.iter().map(|n| if n.n == 0 { Node { a: n.a + base, ..*n } } else { *n }));
+                }
+                Top::Split(b, l, r) => {
+                    let me = out.len();
+                    out.push(Node { min: b.min.to_array(), a: 0, max: b.max.to_array(), n: 0 });
+                    put(*l, out);
+                    out[me].a = out.len() as u32;
+                    put(*r, out);
+                }
+            }
+        }
+        let mut out = Vec::with_capacity(self.len());
+        put(self, &mut out);
+        out
+    }
+}
+
+fn build_morton(items: &mut [Item], codes: &[u64], offset: usize) -> Top {
+    let last = codes.len() - 1;
+    if items.len() <= SAH_RANGE || codes[0] == codes[last] {
+        let bc = bounds_of(items);
+        return Top::Range(build_par(items, offset, bc));
+    }
+    let bit = 63 - (codes[0] ^ codes[last]).leading_zeros();
+    let mid = codes.partition_point(|c| c >> bit & 1 == 0);
+    let (l, r) = items.split_at_mut(mid);
+    let (cl, cr) = codes.split_at(mid);
+    let (left, right) = rayon::join(|| build_morton(l, cl, offset), || build_morton(r, cr, offset + mid));
+    let mut b = left.bounds();
+    b.join(&right.bounds());
+    Top::Split(b, Box::new(left), Box::new(right))
+}
+
 /// Builds the subtree over `items` (which start at `offset` in leaf order, with bounds and
 /// centre bounds `bc`); its root is node 0.
 fn build_par(items: &mut [Item], offset: usize, bc: (Aabb, Aabb)) -> Vec<Node> {
@@ -304,6 +449,10 @@ fn build_par(items: &mut [Item], offset: usize, bc: (Aabb, Aabb)) -> Vec<Node> {
 }
 
 fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, (b, c): (Aabb, Aabb)) {
+    if items.len() <= SMALL {
+        build_small(items, offset, nodes, b);
+        return;
+    }
     let me = nodes.len();
     let (mid, lb, rb) = match split(items, &b, &c) {
         Some(sp) => (partition(items, &c, sp.axis, sp.k), sp.left, sp.right),
@@ -318,6 +467,66 @@ fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, (b, c)
     build_serial(l, offset, nodes, lb);
     nodes[me].a = nodes.len() as u32;
     build_serial(r, offset + mid, nodes, rb);
+}
+
+/// A range of at most [`SMALL`] triangles: the exact SAH split (each boundary between the
+/// centres sorted along their longest axis) and no bins, whose fixed cost (16 bins, two sweeps)
+/// dwarfed the work on so few items: 70% of the build's instructions went there.
+fn build_small(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, b: Aabb) {
+    let n = items.len();
+    if n == 1 {
+        nodes.push(leaf(&b, offset, 1));
+        return;
+    }
+    let mut c = Aabb::EMPTY;
+    items.iter().for_each(|it| c.grow(it.centre()));
+    let axis = longest(c.max - c.min);
+    let key = |it: &Item| (it.centre()[axis], it.id);
+    // Insertion sort: a handful of items; `id` breaks ties so the order is the input's.
+    for i in 1..n {
+        let mut j = i;
+        while j > 0 && key(&items[j - 1]) > key(&items[j]) {
+            items.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    let mut right = [(Aabb::EMPTY, 0.0f32); SMALL];
+    let mut acc = Aabb::EMPTY;
+    for k in (1..n).rev() {
+        acc.join(&items[k].bounds());
+        right[k] = (acc, acc.area() * (n - k) as f32);
+    }
+    let (mut acc, mut best) = (Aabb::EMPTY, (f32::INFINITY, 0, Aabb::EMPTY));
+    for k in 1..n {
+        acc.join(&items[k - 1].bounds());
+        let cost = acc.area() * k as f32 + right[k].1;
+        if cost < best.0 {
+            best = (cost, k, acc);
+        }
+    }
+    let (cost, k, lb) = best;
+    // As in `split`: a node visit costs two triangle tests.
+    if n <= MAX_LEAF && cost + 2.0 * b.area() >= b.area() * n as f32 {
+        nodes.push(leaf(&b, offset, n));
+        return;
+    }
+    let me = nodes.len();
+    nodes.push(Node { min: b.min.to_array(), a: 0, max: b.max.to_array(), n: 0 });
+    let (l, r) = items.split_at_mut(k);
+    build_small(l, offset, nodes, lb);
+    nodes[me].a = nodes.len() as u32;
+    build_small(r, offset + k, nodes, right[k].0);
+}
+
+/// The axis along which `e` is longest (x before y before z on ties).
+fn longest(e: Vec3A) -> usize {
+    if e.x >= e.y && e.x >= e.z {
+        0
+    } else if e.y >= e.z {
+        1
+    } else {
+        2
+    }
 }
 
 #[cfg(test)]
@@ -343,32 +552,59 @@ pub(crate) mod tests {
         t
     }
 
-    /// Every triangle is in exactly one leaf, and every node's box holds its children's.
+    /// Every triangle is in exactly one leaf, and every node's box holds its children's: built
+    /// by binned SAH alone, and with Morton-split upper levels.
     #[test]
     fn leaves_cover_every_triangle_once_and_boxes_nest() {
-        let tris = grid_tris(150);
-        let (bvh, pos) = soup(&tris);
-        let mut seen = vec![0u32; tris.len()];
-        fn walk(b: &Bvh, pos: &[[f32; 3]], i: usize, seen: &mut [u32]) -> (Vec3A, Vec3A) {
-            let n = b.nodes[i];
-            let (lo, hi) = (Vec3A::from(n.min), Vec3A::from(n.max));
-            let (clo, chi) = if n.n > 0 {
-                let mut a = Aabb::EMPTY;
-                for k in n.a as usize..(n.a + n.n) as usize {
-                    seen[b.ids[k] as usize] += 1;
-                    b.corners(pos, k).iter().for_each(|&p| a.grow(p));
-                }
-                (a.min, a.max)
-            } else {
-                let (l0, l1) = walk(b, pos, i + 1, seen);
-                let (r0, r1) = walk(b, pos, n.a as usize, seen);
-                (l0.min(r0), l1.max(r1))
-            };
-            assert!(lo.cmple(clo).all() && hi.cmpge(chi).all(), "node {i} does not hold its children");
-            (lo, hi)
+        for side in [150, 200] {
+            let tris = grid_tris(side);
+            assert_eq!(tris.len() >= MORTON_MIN, side == 200);
+            covered_once_and_nested(&tris);
         }
-        walk(&bvh, &pos, 0, &mut seen);
+    }
+
+    fn covered_once_and_nested(tris: &[[Vec3A; 3]]) {
+        let (bvh, _) = soup(tris);
+        let mut seen = vec![0u32; tris.len()];
+        // The box of what node `i`'s lanes hold, each checked against the lane's own box.
+        fn walk(b: &Bvh, i: usize, seen: &mut [u32]) -> Aabb {
+            let n = b.nodes[i];
+            let mut all = Aabb::EMPTY;
+            for lane in (0..4).filter(|&k| n.lanes & (1 << k) != 0) {
+                let lo = Vec3A::new(n.min[0][lane], n.min[1][lane], n.min[2][lane]);
+                let hi = Vec3A::new(n.max[0][lane], n.max[1][lane], n.max[2][lane]);
+                let held = if n.count[lane] > 0 {
+                    let mut a = Aabb::EMPTY;
+                    let first = n.child[lane] as usize;
+                    for k in first..first + n.count[lane] as usize {
+                        seen[b.ids[k] as usize] += 1;
+                        b.corners(k).iter().for_each(|&p| a.grow(p));
+                    }
+                    a
+                } else {
+                    walk(b, n.child[lane] as usize, seen)
+                };
+                assert!(
+                    lo.cmple(held.min).all() && hi.cmpge(held.max).all(),
+                    "node {i} lane {lane} does not hold its child"
+                );
+                all.join(&held);
+            }
+            all
+        }
+        walk(&bvh, 0, &mut seen);
         assert!(seen.iter().all(|&s| s == 1));
+        // Four-wide: far fewer nodes than triangles.
+        assert!(bvh.nodes.len() * 4 < tris.len(), "{} nodes", bvh.nodes.len());
+    }
+
+    #[test]
+    fn spread_leaves_two_zero_bits_after_each() {
+        for x in [0u64, 1, 0b101, 0xfff, 0xabc] {
+            let mut want = 0;
+            (0..12).for_each(|b| want |= (x >> b & 1) << (3 * b));
+            assert_eq!(spread(x), want, "{x:#x}");
+        }
     }
 
     /// The same tree, node for node, whatever the thread count (large enough for the parallel
@@ -379,8 +615,8 @@ pub(crate) mod tests {
         let build = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
             let (b, _) = pool.install(|| soup(&tris));
-            let nodes: Vec<_> =
-                b.nodes.iter().map(|n| (n.min.map(f32::to_bits), n.a, n.max.map(f32::to_bits), n.n)).collect();
+            let bits = |v: [glam::Vec4; 3]| v.map(|a| a.to_array().map(f32::to_bits));
+            let nodes: Vec<_> = b.nodes.iter().map(|n| (bits(n.min), bits(n.max), n.child, n.count, n.lanes)).collect();
             (nodes, b.tris, b.ids)
         };
         assert!(tris.len() > PARALLEL_MIN * 8);
@@ -394,7 +630,8 @@ pub(crate) mod tests {
     fn duplicates_split_by_count() {
         let t = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
         let (bvh, _) = soup(&vec![t; 1000]);
-        assert!(bvh.nodes.iter().all(|n| n.n as usize <= MAX_LEAF * 2));
-        assert_eq!(bvh.nodes.iter().map(|n| n.n as usize).sum::<usize>(), 1000);
+        let counts = || bvh.nodes.iter().flat_map(|n| n.count);
+        assert!(counts().all(|c| c as usize <= MAX_LEAF * 2));
+        assert_eq!(counts().map(|c| c as usize).sum::<usize>(), 1000);
     }
 }

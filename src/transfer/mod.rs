@@ -16,6 +16,7 @@ pub mod parts;
 pub mod raster;
 pub mod raycast;
 pub mod report;
+pub mod wide;
 
 use crate::error::{Error, Result};
 use crate::format::raw::RawMesh;
@@ -134,9 +135,8 @@ pub fn material_prims(scene: &Scene, m: usize) -> Vec<PrimRef> {
 }
 
 /// HIGH's triangles grouped for the rays of each LOW part: one BVH per set of HIGH parts, all
-/// over HIGH's one array of positions.
+/// holding its triangles' corners in leaf order.
 struct Sets {
-    positions: Vec<[f32; 3]>,
     bvhs: Vec<bvh::Bvh>,
     /// Per set, the HIGH triangle of each BVH id (`None`: the ids are HIGH's own).
     ids: Vec<Option<Vec<u32>>>,
@@ -166,7 +166,7 @@ fn build_sets(
             bvhs[k] = Some(bvh::Bvh::build(&positions, std::mem::take(&mut triangles)));
         }
     }
-    Sets { positions, bvhs: bvhs.into_iter().map(|b| b.expect("every set built")).collect(), ids }
+    Sets { bvhs: bvhs.into_iter().map(|b| b.expect("every set built")).collect(), ids }
 }
 
 /// Bakes HIGH into LOW: one map per material in `materials`, over the triangle primitives that
@@ -190,8 +190,7 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
     let High { positions, triangles, normals, normal_triangles } = high;
     let sets = t.time("bvh", || build_sets(positions, triangles, &high_parts, &groups.sets));
     crate::timings::mem_mark("transfer bvh");
-    let high_bytes = sets.positions.capacity() * 12
-        + sets.bvhs.iter().map(|b| b.bytes()).sum::<usize>()
+    let high_bytes = sets.bvhs.iter().map(|b| b.bytes()).sum::<usize>()
         + sets.ids.iter().flatten().map(|v| v.capacity() * 4).sum::<usize>()
         + normals.capacity() * 12
         + normal_triangles.as_ref().map_or(0, |n| n.capacity() * 12);
@@ -420,7 +419,16 @@ impl Ctx<'_> {
         c.overlapping_samples = samples.overlapping;
         let sw = w * n;
         let mut sums = vec![Vec3A::ZERO; out.len()];
-        for (s, &t) in samples.owner.iter().enumerate() {
+        let mut stack = raycast::Stack::default();
+        // Square tiles of BAND x BAND texels, one after another: neighbouring rays meet the same
+        // part of HIGH's tree while it is still in cache. Each texel's samples keep their order
+        // (rows, then columns), so the sums are the same as row by row.
+        let order = (0..w.div_ceil(BAND)).flat_map(|tx| {
+            let (a, b) = (tx * BAND * n, ((tx + 1) * BAND).min(w) * n);
+            (0..samples.owner.len() / sw).flat_map(move |sy| (a..b).map(move |sx| sy * sw + sx))
+        });
+        for s in order {
+            let t = samples.owner[s];
             if t == u32::MAX {
                 continue;
             }
@@ -428,7 +436,7 @@ impl Ctx<'_> {
             let (x, y) = raster::sample_pos(sx, sy, y0, n);
             let texel = (sy / n) * w + sx / n;
             let e = edges[t as usize].as_ref().expect("owners have edges");
-            let r = self.sample(t as usize, e.bary(x, y), &mut c);
+            let r = self.sample(t as usize, e.bary(x, y), &mut c, &mut stack);
             let part = self.low.tri_part[t as usize];
             let ps = &mut parts[part as usize];
             ps.rays += 1;
@@ -464,7 +472,7 @@ impl Ctx<'_> {
     }
 
     /// One ray from LOW triangle `t` at barycentrics `b`.
-    fn sample(&self, t: usize, b: [f32; 3], c: &mut Counts) -> Sample {
+    fn sample(&self, t: usize, b: [f32; 3], c: &mut Counts, stack: &mut raycast::Stack) -> Sample {
         let low = self.low;
         let tri = low.triangles[t];
         let mix = |f: &dyn Fn(usize) -> Vec3A| {
@@ -499,7 +507,7 @@ impl Ctx<'_> {
         };
         let set = self.low_set[low.tri_part[t] as usize];
         let tree = &self.sets.bvhs[set];
-        let Some(hit) = raycast::nearest(tree, &self.sets.positions, &raycast::Ray::new(p, dir), back, front) else {
+        let Some(hit) = raycast::nearest(tree, &raycast::Ray::new(p, dir), back, front, stack) else {
             c.missed_rays += 1;
             return flat;
         };

@@ -6,7 +6,7 @@
 //! zero in f32 are recomputed in f64, as the paper advises. Degenerate triangles never hit.
 
 use super::bvh::Bvh;
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 
 /// A ray prepared for the watertight test (its shear is computed once).
 #[derive(Debug, Clone, Copy)]
@@ -92,17 +92,6 @@ pub fn intersect(ray: &Ray, v: &[Vec3A; 3]) -> Option<(f32, [f32; 3])> {
     Some((t, [u * inv, v * inv, w * inv]))
 }
 
-/// The slab test: the part of `[lo, hi]` inside the node's box, if any.
-#[inline]
-fn slab(ray: &Ray, min: &[f32; 3], max: &[f32; 3], lo: f32, hi: f32) -> Option<(f32, f32)> {
-    let t0 = (Vec3A::from(*min) - ray.origin) * ray.inv;
-    let t1 = (Vec3A::from(*max) - ray.origin) * ray.inv;
-    // NaN (0 * inf, a ray in the box's plane) must not narrow the range: max/min drop it.
-    let near = t0.min(t1).max_element().max(lo);
-    let far = t0.max(t1).min_element().min(hi);
-    (near <= far).then_some((near, far))
-}
-
 /// How far the interval `[a, b]` is from 0.
 #[inline]
 fn gap(a: f32, b: f32) -> f32 {
@@ -115,76 +104,117 @@ fn gap(a: f32, b: f32) -> f32 {
     }
 }
 
+/// A node or a leaf still to visit, and how far its part of the ray lies from the origin: one
+/// whose gap is beyond the best hit so far is dropped without another box test.
+#[derive(Clone, Copy)]
+struct Todo {
+    child: u32,
+    /// 0 for a node, else the leaf's triangle count.
+    count: u32,
+    gap: f32,
+}
+
+/// The nodes and leaves a ray has still to visit: one per thread, reused ray after ray.
+#[derive(Default)]
+pub struct Stack(Vec<Todo>);
+
 /// The hit nearest the ray's origin with `t` in `[-back, front]`.
-pub fn nearest(bvh: &Bvh, positions: &[[f32; 3]], ray: &Ray, back: f32, front: f32) -> Option<Hit> {
+///
+/// A node's four slab tests are those of the binary tree, lane by lane, in the same arithmetic
+/// (and with the same NaN rule: `_mm_min_ps`/`_mm_max_ps` keep the second operand); children are
+/// visited nearest first. Which hit wins never depends on the order: see [`Hit::better_than`].
+pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -> Option<Hit> {
     if bvh.is_empty() {
         return None;
     }
     let mut best: Option<Hit> = None;
     let (mut lo, mut hi) = (-back, front);
-    // Nodes still to visit, with how far their part of the ray lies from the origin: a node
-    // whose gap is beyond the best hit so far is dropped without another box test.
-    let mut stack = [(0u32, 0.0f32); 96];
-    let mut sp = 0;
-    let root = &bvh.nodes[0];
-    slab(ray, &root.min, &root.max, lo, hi)?;
-    let mut node = 0usize;
+    let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
+    let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
+    let nothing = Todo { child: 0, count: 0, gap: 0.0 };
+    let stack = &mut stack.0;
+    stack.clear();
+    let mut todo = nothing;
     loop {
-        let n = &bvh.nodes[node];
-        if n.n > 0 {
-            for k in n.a as usize..(n.a + n.n) as usize {
-                if let Some((t, bary)) = intersect(ray, &bvh.corners(positions, k)) {
-                    if t < lo || t > hi {
-                        continue;
-                    }
-                    let h = Hit { t, id: bvh.ids[k], slot: k as u32, bary };
-                    if best.as_ref().map(|b| h.better_than(b)).unwrap_or(true) {
-                        best = Some(h);
-                        // Nothing farther than this hit can win; equal distances still can
-                        // (lower index), so the range stays closed.
-                        lo = lo.max(-t.abs());
-                        hi = hi.min(t.abs());
-                    }
-                }
-            }
-        } else {
-            let (l, r) = (node + 1, n.a as usize);
-            let sl = slab(ray, &bvh.nodes[l].min, &bvh.nodes[l].max, lo, hi).map(|(a, b)| gap(a, b));
-            let sr = slab(ray, &bvh.nodes[r].min, &bvh.nodes[r].max, lo, hi).map(|(a, b)| gap(a, b));
-            match (sl, sr) {
-                (Some(a), Some(b)) => {
-                    let (first, second, g) = if a <= b { (l, r, b) } else { (r, l, a) };
-                    if sp < stack.len() {
-                        stack[sp] = (second as u32, g);
-                        sp += 1;
-                    }
-                    node = first;
-                    continue;
-                }
-                (Some(_), None) => {
-                    node = l;
-                    continue;
-                }
-                (None, Some(_)) => {
-                    node = r;
-                    continue;
-                }
-                (None, None) => {}
-            }
+        if let Some(next) = visit(bvh, ray, todo, &o, &inv, &mut lo, &mut hi, &mut best, stack) {
+            todo = next;
+            continue;
         }
-        // Pop the next node that can still hold a hit as near as the best.
+        // The next node or leaf that can still hold a hit as near as the best.
         loop {
-            if sp == 0 {
-                return best;
-            }
-            sp -= 1;
-            let (c, g) = stack[sp];
-            if g <= hi.max(-lo) {
-                node = c as usize;
+            let Some(t) = stack.pop() else { return best };
+            if t.gap <= hi.max(-lo) {
+                todo = t;
                 break;
             }
         }
     }
+}
+
+/// Tests a leaf's triangles, or a node's four boxes: the children hit are pushed, farthest
+/// first, except the nearest, which is returned to be visited next.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn visit(
+    bvh: &Bvh,
+    ray: &Ray,
+    todo: Todo,
+    o: &[Vec4; 3],
+    inv: &[Vec4; 3],
+    lo: &mut f32,
+    hi: &mut f32,
+    best: &mut Option<Hit>,
+    stack: &mut Vec<Todo>,
+) -> Option<Todo> {
+    if todo.count > 0 {
+        for k in todo.child as usize..(todo.child + todo.count) as usize {
+            let Some((t, bary)) = intersect(ray, &bvh.corners(k)) else { continue };
+            if t < *lo || t > *hi {
+                continue;
+            }
+            let h = Hit { t, id: bvh.ids[k], slot: k as u32, bary };
+            if best.as_ref().is_none_or(|b| h.better_than(b)) {
+                *best = Some(h);
+                // Nothing farther than this hit can win; equal distances still can (lower
+                // index), so the range stays closed.
+                *lo = lo.max(-t.abs());
+                *hi = hi.min(t.abs());
+            }
+        }
+        return None;
+    }
+    let n = &bvh.nodes[todo.child as usize];
+    let slab = |a: usize| {
+        let t0 = (n.min[a] - o[a]) * inv[a];
+        let t1 = (n.max[a] - o[a]) * inv[a];
+        (t0.min(t1), t0.max(t1))
+    };
+    let ((ax, bx), (ay, by), (az, bz)) = (slab(0), slab(1), slab(2));
+    let near = ax.max(az).max(ay.max(az)).max(Vec4::splat(*lo));
+    let far = bx.min(bz).min(by.min(bz)).min(Vec4::splat(*hi));
+    let mut mask = near.cmple(far).bitmask() & n.lanes;
+    if mask == 0 {
+        return None;
+    }
+    // Sorted by gap, farthest first (ties: the lower lane last, so it is visited first, as the
+    // binary tree's left child was).
+    let (near, far) = (near.to_array(), far.to_array());
+    let mut kids = [Todo { child: 0, count: 0, gap: 0.0 }; 4];
+    let mut len = 0;
+    while mask != 0 {
+        let lane = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let kid = Todo { child: n.child[lane], count: n.count[lane] as u32, gap: gap(near[lane], far[lane]) };
+        let mut i = len;
+        while i > 0 && kids[i - 1].gap <= kid.gap {
+            kids[i] = kids[i - 1];
+            i -= 1;
+        }
+        kids[i] = kid;
+        len += 1;
+    }
+    stack.extend_from_slice(&kids[..len - 1]);
+    Some(kids[len - 1])
 }
 
 #[cfg(test)]
@@ -234,11 +264,11 @@ mod tests {
     fn nearest_on_either_side() {
         let sheet = |z: f32| [Vec3A::new(-1.0, -1.0, z), Vec3A::new(1.0, -1.0, z), Vec3A::new(0.0, 1.0, z)];
         let tris: Vec<[Vec3A; 3]> = [0.5f32, -0.2, 0.9, -0.7].iter().map(|&z| sheet(z)).collect();
-        let (bvh, pos) = crate::transfer::bvh::tests::soup(&tris);
+        let (bvh, _) = crate::transfer::bvh::tests::soup(&tris);
         let r = Ray::new(Vec3A::ZERO, Vec3A::Z);
-        let h = nearest(&bvh, &pos, &r, 1.0, 1.0).unwrap();
+        let h = nearest(&bvh, &r, 1.0, 1.0, &mut Stack::default()).unwrap();
         assert_eq!((h.id, h.t), (1, -0.2));
-        assert_eq!(nearest(&bvh, &pos, &r, 0.1, 0.6).unwrap().id, 0);
-        assert!(nearest(&bvh, &pos, &r, 0.1, 0.4).is_none());
+        assert_eq!(nearest(&bvh, &r, 0.1, 0.6, &mut Stack::default()).unwrap().id, 0);
+        assert!(nearest(&bvh, &r, 0.1, 0.4, &mut Stack::default()).is_none());
     }
 }
