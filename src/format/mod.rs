@@ -12,6 +12,7 @@ pub mod image;
 mod ktx2;
 mod meshopt;
 mod obj;
+mod obj_block;
 mod obj_fast;
 pub mod obj_parse;
 pub mod ply;

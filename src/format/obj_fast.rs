@@ -40,6 +40,11 @@ fn end_of_line(b: &[u8], mut i: usize) -> Option<usize> {
 fn fast_index(b: &[u8], mut i: usize, limit: u64) -> Option<(u32, usize)> {
     let s = i;
     let mut x: u64 = 0;
+    if let Some((n, v)) = digits8(b, i) {
+        if n < 8 {
+            return (v >= 1 && v <= limit).then(|| ((v - 1) as u32, i + n));
+        }
+    }
     while i < b.len() && b[i].is_ascii_digit() && i - s < 10 {
         x = x * 10 + (b[i] - b'0') as u64;
         i += 1;
@@ -103,6 +108,33 @@ pub(super) fn parse_int(t: &[u8]) -> Option<i64> {
     Some(if neg { -x } else { x })
 }
 
+/// The leading decimal digits of `b[i..]`, up to eight, read at once when eight bytes are there:
+/// how many there are (8 when there may be more) and their value.
+#[inline]
+fn digits8(b: &[u8], i: usize) -> Option<(usize, u64)> {
+    let chunk = u64::from_le_bytes(b.get(i..i + 8)?.try_into().ok()?);
+    let sub = chunk.wrapping_sub(0x3030_3030_3030_3030);
+    // A byte's top bit is set in one of these if it is below '0', above '9' or not ASCII; bytes
+    // after the first such one may be garbled by carries, and are not looked at.
+    let flags = (sub | chunk.wrapping_add(0x4646_4646_4646_4646) | chunk) & 0x8080_8080_8080_8080;
+    let n = (flags.trailing_zeros() / 8) as usize;
+    if n == 0 {
+        return Some((0, 0));
+    }
+    // The digits moved to the high bytes, zeros (as digits) before them: eight digits, parsed
+    // as in simdjson's parse_eight_digits_unrolled.
+    let mut v = sub << (8 * (8 - n));
+    v = v.wrapping_mul(10).wrapping_add(v >> 8);
+    let mask = 0x0000_00FF_0000_00FF;
+    v = (v & mask)
+        .wrapping_mul(100 + (1_000_000 << 32))
+        .wrapping_add(((v >> 16) & mask).wrapping_mul(1 + (10_000 << 32)))
+        >> 32;
+    Some((n, v & 0xFFFF_FFFF))
+}
+
+const POW10_INT: [u64; 9] = [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000, 100_000_000];
+
 const POW10: [f64; 23] = [
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
     1e21, 1e22,
@@ -137,6 +169,22 @@ pub fn lead_f32(t: &[u8]) -> Option<(f32, usize)> {
         _ => (false, 0),
     };
     let (mut w, mut e, mut digits) = (0u64, 0i32, 0);
+    // Eight digits at a time while the mantissa stays far below the per-digit limit (1e17).
+    let run = |w: &mut u64, p: &mut usize, digits: &mut i32| -> i32 {
+        let mut taken = 0;
+        while *w < 1_000_000_000 {
+            let Some((n, v)) = digits8(t, *p) else { break };
+            *w = *w * POW10_INT[n] + v;
+            *p += n;
+            taken += n as i32;
+            if n < 8 {
+                break;
+            }
+        }
+        *digits += taken;
+        taken
+    };
+    run(&mut w, &mut p, &mut digits);
     while p < t.len() && t[p].is_ascii_digit() {
         if w >= 100_000_000_000_000_000 {
             return slow();
@@ -147,6 +195,7 @@ pub fn lead_f32(t: &[u8]) -> Option<(f32, usize)> {
     }
     if p < t.len() && t[p] == b'.' {
         p += 1;
+        e -= run(&mut w, &mut p, &mut digits);
         while p < t.len() && t[p].is_ascii_digit() {
             if w >= 100_000_000_000_000_000 {
                 return slow();

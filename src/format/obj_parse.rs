@@ -1,29 +1,28 @@
 //! Wavefront OBJ geometry, parsed on every core at memory speed.
 //!
-//! The file is read in blocks; each block is cut at line starts into pieces of about a megabyte,
-//! the pieces are parsed in parallel and appended in file order, so the result never depends on
-//! the thread count or the piece size. A first quick pass counts each piece's `v`/`vt`/`vn`
-//! lines, so every piece knows the index its lines start at: relative (negative) indices are
-//! resolved and indices checked during the parallel parse, with the file's own line numbers.
-//! Only a reference to an element defined further down (legal, rare) waits for the end of the
-//! file to be checked.
+//! A file is read through a memory map, a window of a block (64 MB) at a time, so its text is
+//! never copied and only one window of it is mapped at once; other readers (a pipe) and bytes in
+//! memory go through the same blocks. Each block is parsed in parallel pieces and appended in
+//! file order (`obj_block.rs`), so the result never depends on the thread count or the piece
+//! size. Errors name the file's own line numbers.
 //!
 //! Values are kept as the file stores them (UV v up); the glue in `obj.rs` (a Scene) and
 //! `raw.rs` (a RawMesh) converts. Polygons are fanned from their first corner, as `tobj` did.
 
+use super::obj_block::Acc;
 use super::obj_fast::{fast_corners, fast_floats, parse_int};
 pub use super::obj_fast::{lead_f32, parse_f32};
 use crate::error::{Error, Result};
 use crate::progress::{Counting, Reporter};
-use memchr::memchr;
-use rayon::prelude::*;
+use memchr::{memchr, memrchr};
 use std::io::Read;
+use std::ops::Deref;
 use std::path::Path;
 
 /// The index of a corner that names no `vt` (or no `vn`).
 pub const MISSING: u32 = u32::MAX;
 
-/// Pieces are cut at about this many bytes; blocks of this many pieces are read at a time.
+/// Pieces are cut at about this many bytes; blocks of this many pieces are parsed at a time.
 const PIECE: usize = 1 << 20;
 const PIECES_PER_BLOCK: usize = 64;
 
@@ -58,13 +57,28 @@ pub struct ObjData {
 /// Reads and parses the OBJ file at `path`, a block at a time, reporting the bytes read as the
 /// progress stage `read NAME`.
 pub fn parse_file(path: &Path, progress: &Reporter) -> Result<ObjData> {
-    let file = std::fs::File::open(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
-    let len = file.metadata().map_or(0, |m| m.len());
-    reported(path, len, progress, |p| parse_reader(path, Counting::new(file, p), piece_for(len)))
+    let cannot = |e: std::io::Error| Error::input(path, format!("cannot read: {e}"));
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let meta = file.metadata().map_err(cannot)?;
+    let len = meta.len();
+    reported(path, len, progress, |p| {
+        let map = |at: u64, n: usize| {
+            // SAFETY: the map is only read, and dropped before the next one. Like every reader
+            // that maps a file, this trusts nothing to truncate the file while it is read.
+            unsafe { memmap2::MmapOptions::new().offset(at).len(n).map(&file) }
+        };
+        if meta.is_file() && len > 0 && map(0, 1).is_ok() {
+            windows::<true, _>(path, len, piece_for(len), p, |at, n| map(at, n).map_err(cannot))
+        } else {
+            // Empty, or not mappable (a pipe): read it.
+            parse_reader(path, Counting::new(&file, p), piece_for(len))
+        }
+    })
 }
 
 /// Pieces for a file of `len` bytes: [`PIECE`], or smaller for a file under a block, so that a
-/// small file's buffer is its own size and not a whole block's (zeroed before the read fills it).
+/// small file is still cut into pieces for every core and, read through a buffer, gets a buffer
+/// its own size and not a whole block's (zeroed before the read fills it).
 fn piece_for(len: u64) -> usize {
     PIECE.min(usize::try_from(len).unwrap_or(usize::MAX) / PIECES_PER_BLOCK + 4096)
 }
@@ -72,7 +86,13 @@ fn piece_for(len: u64) -> usize {
 /// Parses OBJ bytes already in memory, reported as [`parse_file`] reports a file.
 pub fn parse_bytes(path: &Path, bytes: &[u8], progress: &Reporter) -> Result<ObjData> {
     let piece = piece_for(bytes.len() as u64);
-    reported(path, bytes.len() as u64, progress, |p| parse_reader(path, Counting::new(bytes, p), piece))
+    reported(path, bytes.len() as u64, progress, |p| parse_pieces::<true>(path, bytes, piece, p))
+}
+
+/// [`parse_bytes`] with pieces of about `piece` bytes (small in tests, to cut lines everywhere),
+/// with or without the common lines' own path (the tests compare the two).
+fn parse_pieces<const FAST: bool>(path: &Path, bytes: &[u8], piece: usize, progress: &Reporter) -> Result<ObjData> {
+    windows::<FAST, _>(path, bytes.len() as u64, piece, progress, |at, n| Ok(&bytes[at as usize..][..n]))
 }
 
 fn reported(
@@ -88,16 +108,42 @@ fn reported(
     out
 }
 
-/// Parses from `r` with pieces of about `piece` bytes (small in tests, to cut lines everywhere).
-pub fn parse_reader(path: &Path, r: impl Read, piece: usize) -> Result<ObjData> {
-    parse_with::<true>(path, r, piece)
+/// Parses `len` bytes seen through `window(at, n)` (bytes `at..at + n`), a block at a time: each
+/// window runs to the last line end in it (it grows when one line is longer than a block).
+fn windows<const FAST: bool, W: Deref<Target = [u8]>>(
+    path: &Path,
+    len: u64,
+    piece: usize,
+    progress: &Reporter,
+    mut window: impl FnMut(u64, usize) -> Result<W>,
+) -> Result<ObjData> {
+    let piece = piece.max(1);
+    let mut acc = Acc::new(progress.clone());
+    let mut at = 0;
+    let mut want = piece * PIECES_PER_BLOCK;
+    while at < len {
+        let n = usize::try_from(len - at).unwrap_or(usize::MAX).min(want);
+        let w = window(at, n)?;
+        let last = at + n as u64 == len;
+        let Some(cut) = (if last { Some(n) } else { memrchr(b'\n', &w).map(|i| i + 1) }) else {
+            want *= 2;
+            continue;
+        };
+        let start = if at == 0 && w.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
+        progress.tick(start.min(cut) as u64);
+        acc.block::<FAST>(path, &w[start.min(cut)..cut], piece)?;
+        at += cut as u64;
+        want = piece * PIECES_PER_BLOCK;
+    }
+    acc.finish(path)
 }
 
-/// [`parse_reader`], with or without the common lines' own path (the tests compare the two).
-fn parse_with<const FAST: bool>(path: &Path, mut r: impl Read, piece: usize) -> Result<ObjData> {
+/// Parses from `r`, read a block at a time into one buffer, with pieces of about `piece` bytes.
+pub fn parse_reader(path: &Path, mut r: impl Read, piece: usize) -> Result<ObjData> {
     let piece = piece.max(1);
     let block = piece * PIECES_PER_BLOCK;
-    let mut acc = Acc::default();
+    // `r` reports its own bytes as they are read.
+    let mut acc = Acc::new(Reporter::none());
     // `buf[..kept]` holds what the last block left (a line not yet ended); the buffer keeps its
     // length between blocks, so it is zeroed once, not at every block.
     let mut buf: Vec<u8> = Vec::new();
@@ -125,141 +171,28 @@ fn parse_with<const FAST: bool>(path: &Path, mut r: impl Read, piece: usize) -> 
         let data = &buf[..filled];
         let start = if first && data.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
         first = false;
-        let cut = if eof { filled } else { data.iter().rposition(|&c| c == b'\n').map_or(start, |i| i + 1) };
-        acc.block::<FAST>(path, &data[start..cut], piece)?;
+        let cut = if eof { filled } else { memrchr(b'\n', data).map_or(start, |i| i + 1) };
+        acc.block::<true>(path, &data[start..cut], piece)?;
         buf.copy_within(cut..filled, 0);
         kept = filled - cut;
     }
     acc.finish(path)
 }
 
+/// How many `v`, `vt`, `vn` and lines a piece holds (or come before it).
 #[derive(Default, Clone, Copy)]
-struct Counts {
-    v: u64,
-    t: u64,
-    n: u64,
-    lines: u64,
+pub(super) struct Counts {
+    pub v: u64,
+    pub t: u64,
+    pub n: u64,
+    pub lines: u64,
 }
 
 /// A reference past what was defined when its face was read, checked at the end.
-struct Forward {
-    attr: u8,
-    index: u32,
-    line: u64,
-}
-
-#[derive(Default)]
-struct Acc {
-    data: ObjData,
-    any_t: bool,
-    any_n: bool,
-    forward: Vec<Forward>,
-    lines: u64,
-}
-
-impl Acc {
-    fn block<const FAST: bool>(&mut self, path: &Path, bytes: &[u8], piece: usize) -> Result<()> {
-        let pieces = split(bytes, piece);
-        let counts: Vec<Counts> = pieces.par_iter().map(|p| count(p)).collect();
-        let mut bases = Vec::with_capacity(pieces.len());
-        let mut b = Counts {
-            v: self.data.positions.len() as u64,
-            t: self.data.uvs.len() as u64,
-            n: self.data.normals.len() as u64,
-            lines: self.lines,
-        };
-        for c in &counts {
-            bases.push(b);
-            b = Counts { v: b.v + c.v, t: b.t + c.t, n: b.n + c.n, lines: b.lines + c.lines };
-        }
-        if b.v.max(b.t).max(b.n) >= MISSING as u64 {
-            return Err(Error::input(path, "more than 4 billion vertices: too large for 32-bit indices"));
-        }
-        let parsed: Vec<std::result::Result<Piece, (u64, String)>> =
-            pieces.par_iter().zip(&bases).map(|(p, base)| Piece::parse::<FAST>(p, *base)).collect();
-        for p in parsed {
-            let p = p.map_err(|(line, msg)| Error::input(path, format!("OBJ line {line}: {msg}")))?;
-            self.append(p);
-        }
-        self.lines = b.lines;
-        Ok(())
-    }
-
-    fn append(&mut self, p: Piece) {
-        let d = &mut self.data;
-        let before = d.tri_v.len();
-        let tris = p.tv.len();
-        for (at, s) in p.statements {
-            d.statements.push((at + before as u32, s));
-        }
-        d.mtllibs.extend(p.mtllibs);
-        d.positions.extend_from_slice(&p.pos);
-        d.normals.extend_from_slice(&p.nrm);
-        d.uvs.extend_from_slice(&p.uv);
-        d.tri_v.extend_from_slice(&p.tv);
-        let attrs = [(&mut self.any_t, &mut d.tri_t, &p.tt, p.any_t), (&mut self.any_n, &mut d.tri_n, &p.tn, p.any_n)];
-        for (any, mine, theirs, piece_has) in attrs {
-            if piece_has && !*any {
-                *any = true;
-                mine.resize(before, [MISSING; 3]);
-            }
-            if *any {
-                if !piece_has {
-                    mine.resize(before + tris, [MISSING; 3]);
-                } else {
-                    mine.extend_from_slice(theirs);
-                }
-            }
-        }
-        self.forward.extend(p.forward);
-    }
-
-    fn finish(mut self, path: &Path) -> Result<ObjData> {
-        let d = &mut self.data;
-        let totals = [d.positions.len(), d.uvs.len(), d.normals.len()];
-        for f in &self.forward {
-            // Indices into a kind the file never defines are ignored, as tobj did.
-            if f.index as usize >= totals[f.attr as usize] && (f.attr == 0 || totals[f.attr as usize] > 0) {
-                let what = ["vertex", "texture coordinate", "normal"][f.attr as usize];
-                return Err(Error::input(
-                    path,
-                    format!(
-                        "OBJ line {}: {what} index {} is past the {} defined in the file (indices start at 1; negative ones count back from the last)",
-                        f.line,
-                        f.index as u64 + 1,
-                        totals[f.attr as usize]
-                    ),
-                ));
-            }
-        }
-        if d.uvs.is_empty() {
-            d.tri_t.clear();
-        }
-        if d.normals.is_empty() {
-            d.tri_n.clear();
-        }
-        Ok(self.data)
-    }
-}
-
-/// Cuts `bytes` after a newline near every `piece` bytes.
-fn split(bytes: &[u8], piece: usize) -> Vec<&[u8]> {
-    let mut out = Vec::with_capacity(bytes.len() / piece + 1);
-    let mut rest = bytes;
-    while rest.len() > piece {
-        match memchr(b'\n', &rest[piece - 1..]) {
-            Some(k) => {
-                let (a, b) = rest.split_at(piece + k);
-                out.push(a);
-                rest = b;
-            }
-            None => break,
-        }
-    }
-    if !rest.is_empty() || out.is_empty() {
-        out.push(rest);
-    }
-    out
+pub(super) struct Forward {
+    pub attr: u8,
+    pub index: u32,
+    pub line: u64,
 }
 
 #[derive(PartialEq, Clone, Copy)]
@@ -304,7 +237,7 @@ fn line_end(b: &[u8], i: usize) -> usize {
     memchr(b'\n', &b[i.min(b.len())..]).map_or(b.len(), |k| i + k)
 }
 
-fn count(b: &[u8]) -> Counts {
+pub(super) fn count(b: &[u8]) -> Counts {
     let mut c = Counts::default();
     let mut i = 0;
     while i < b.len() {
@@ -323,19 +256,49 @@ fn count(b: &[u8]) -> Counts {
     c
 }
 
+/// One piece of a block, as parsed; its arrays are cleared and reused for the next block.
 #[derive(Default)]
-struct Piece {
-    pos: Vec<[f32; 3]>,
-    nrm: Vec<[f32; 3]>,
-    uv: Vec<[f32; 2]>,
-    tv: Vec<[u32; 3]>,
-    tt: Vec<[u32; 3]>,
-    tn: Vec<[u32; 3]>,
-    statements: Vec<(u32, Statement)>,
-    mtllibs: Vec<String>,
-    forward: Vec<Forward>,
-    any_t: bool,
-    any_n: bool,
+pub(super) struct Piece {
+    pub pos: Vec<[f32; 3]>,
+    pub nrm: Vec<[f32; 3]>,
+    pub uv: Vec<[f32; 2]>,
+    pub tv: Vec<[u32; 3]>,
+    pub tt: Vec<[u32; 3]>,
+    pub tn: Vec<[u32; 3]>,
+    /// With the number of the piece's triangles before each.
+    pub statements: Vec<(u32, Statement)>,
+    pub mtllibs: Vec<String>,
+    /// With the piece's own line numbers (its first line is 1).
+    pub forward: Vec<Forward>,
+    pub any_t: bool,
+    pub any_n: bool,
+    /// The largest `v`, `vt` and `vn` index the faces name, plus one (0 for none).
+    pub max: [u32; 3],
+    /// The piece's `v`/`vt`/`vn` and lines.
+    pub counts: Counts,
+    /// Parsed without its base, it stopped at a relative index: it must be parsed again.
+    pub needs_base: bool,
+    /// The first error, at the piece's own line number.
+    pub error: Option<(u64, String)>,
+}
+
+/// Why a line stops the piece.
+enum Stop {
+    /// A relative index, in a piece parsed without its base.
+    NeedsBase,
+    Error(String),
+}
+
+impl From<String> for Stop {
+    fn from(s: String) -> Stop {
+        Stop::Error(s)
+    }
+}
+
+impl From<&str> for Stop {
+    fn from(s: &str) -> Stop {
+        Stop::Error(s.to_string())
+    }
 }
 
 pub(super) type Corner = [u32; 3];
@@ -377,16 +340,25 @@ impl Piece {
     /// Parses one piece; with `FAST` (always, but in the tests that compare both), the common
     /// lines (`v`/`vn`/`vt` with plain numbers, faces of positive indices already defined) take a
     /// path of their own; anything else on such a line sends it down the general path.
-    fn parse<const FAST: bool>(b: &[u8], base: Counts) -> std::result::Result<Piece, (u64, String)> {
-        let mut p = Piece::default();
+    ///
+    /// `base` is how many `v`, `vt` and `vn` come before the piece. Without it (`None`), indices
+    /// are not checked against what is defined so far, and a relative index stops the parse with
+    /// `needs_base` set.
+    pub(super) fn parse<const FAST: bool>(&mut self, b: &[u8], base: Option<[u64; 3]>) {
+        self.clear();
         let mut i = 0;
-        let mut line = base.lines;
+        let mut line = 0;
         let mut corners: Vec<Corner> = Vec::new();
         let mut pending: Vec<Forward> = Vec::new();
+        // Without a base, every index a face names counts as defined already.
+        let limit = |p: &Piece| match base {
+            Some(b) => [b[0] + p.pos.len() as u64, b[1] + p.uv.len() as u64, b[2] + p.nrm.len() as u64],
+            None => [MISSING as u64; 3],
+        };
         while i < b.len() {
             line += 1;
             if FAST {
-                if let Some(next) = p.fast_line(b, i, base, &mut corners) {
+                if let Some(next) = self.fast_line(b, i, limit(self), &mut corners) {
                     i = next;
                     continue;
                 }
@@ -394,51 +366,76 @@ impl Piece {
             let end = line_end(b, i);
             let (kind, after) = keyword(b, i);
             let mut l = Line { b: &b[..end], i: after };
-            let r = match kind {
-                Kind::V => p.vertex(&mut l),
+            let r: std::result::Result<(), Stop> = match kind {
+                Kind::V => self.vertex(&mut l).map_err(Stop::from),
                 Kind::Vt => (|| {
-                    p.uv.push([l.float("vt")?, l.float("vt")?]);
+                    self.uv.push([l.float("vt")?, l.float("vt")?]);
                     Ok(())
                 })(),
                 Kind::Vn => (|| {
-                    p.nrm.push([l.float("vn")?, l.float("vn")?, l.float("vn")?]);
+                    self.nrm.push([l.float("vn")?, l.float("vn")?, l.float("vn")?]);
                     Ok(())
                 })(),
                 Kind::F => {
-                    let now = [base.v + p.pos.len() as u64, base.t + p.uv.len() as u64, base.n + p.nrm.len() as u64];
-                    p.face(&mut l, now, line, &mut corners, &mut pending)
+                    let now = base.map(|_| limit(self));
+                    self.face(&mut l, now, line, &mut corners, &mut pending)
                 }
                 Kind::Name => {
                     let name = l.rest();
                     let name = if name.is_empty() { "unnamed_object".to_string() } else { name };
-                    p.statements.push((p.tv.len() as u32, Statement::Name(name)));
+                    self.statements.push((self.tv.len() as u32, Statement::Name(name)));
                     Ok(())
                 }
                 Kind::Usemtl => {
                     let name = l.rest();
                     if name.is_empty() {
-                        Err("usemtl names no material".to_string())
+                        Err("usemtl names no material".into())
                     } else {
-                        p.statements.push((p.tv.len() as u32, Statement::Material(name)));
+                        self.statements.push((self.tv.len() as u32, Statement::Material(name)));
                         Ok(())
                     }
                 }
                 Kind::Mtllib => {
-                    p.mtllibs.push(l.rest());
+                    self.mtllibs.push(l.rest());
                     Ok(())
                 }
                 Kind::Other => Ok(()),
             };
-            r.map_err(|m| (line, m))?;
-            i = end + 1;
+            match r {
+                Ok(()) => i = end + 1,
+                Err(Stop::NeedsBase) => {
+                    self.needs_base = true;
+                    return;
+                }
+                Err(Stop::Error(m)) => {
+                    self.error = Some((line, m));
+                    return;
+                }
+            }
         }
-        Ok(p)
+        self.counts =
+            Counts { v: self.pos.len() as u64, t: self.uv.len() as u64, n: self.nrm.len() as u64, lines: line };
+    }
+
+    fn clear(&mut self) {
+        for v in [&mut self.pos, &mut self.nrm] {
+            v.clear();
+        }
+        self.uv.clear();
+        for v in [&mut self.tv, &mut self.tt, &mut self.tn] {
+            v.clear();
+        }
+        self.statements.clear();
+        self.mtllibs.clear();
+        self.forward.clear();
+        (self.any_t, self.any_n, self.max, self.counts) = (false, false, [0; 3], Counts::default());
+        (self.needs_base, self.error) = (false, None);
     }
 
     /// The line at `i` if it is a common one, parsed; where the next line starts. `None` (nothing
     /// kept) for any other line, which the general path then reads.
     #[inline]
-    fn fast_line(&mut self, b: &[u8], i: usize, base: Counts, corners: &mut Vec<Corner>) -> Option<usize> {
+    fn fast_line(&mut self, b: &[u8], i: usize, limit: [u64; 3], corners: &mut Vec<Corner>) -> Option<usize> {
         let (c0, c1) = (b[i], *b.get(i + 1)?);
         if c0 == b'v' {
             if c1 == b' ' {
@@ -463,8 +460,7 @@ impl Piece {
         if c0 != b'f' || c1 != b' ' {
             return None;
         }
-        let now = [base.v + self.pos.len() as u64, base.t + self.uv.len() as u64, base.n + self.nrm.len() as u64];
-        let next = fast_corners(b, i + 2, now, corners)?;
+        let next = fast_corners(b, i + 2, limit, corners)?;
         self.fan(corners);
         Some(next)
     }
@@ -495,14 +491,16 @@ impl Piece {
         Ok(())
     }
 
+    /// A face line; `now` is how many of each kind are defined so far, `None` when the piece's
+    /// base is not known.
     fn face(
         &mut self,
         l: &mut Line,
-        now: [u64; 3],
+        now: Option<[u64; 3]>,
         line: u64,
         corners: &mut Vec<Corner>,
         pending: &mut Vec<Forward>,
-    ) -> std::result::Result<(), String> {
+    ) -> std::result::Result<(), Stop> {
         corners.clear();
         pending.clear();
         while let Some(t) = l.token() {
@@ -512,7 +510,7 @@ impl Piece {
                     continue;
                 }
                 if k > 2 {
-                    return Err(format!("face corner '{}' has more than v/vt/vn", String::from_utf8_lossy(t)));
+                    return Err(format!("face corner '{}' has more than v/vt/vn", String::from_utf8_lossy(t)).into());
                 }
                 let x = parse_int(part).ok_or_else(|| {
                     format!("face corner '{}' is not v, v/vt, v//vn or v/vt/vn", String::from_utf8_lossy(t))
@@ -521,21 +519,23 @@ impl Piece {
                 let idx = if x > 0 {
                     x - 1
                 } else if x < 0 {
+                    let Some(now) = now else { return Err(Stop::NeedsBase) };
                     let r = now[k] as i64 + x;
                     if r < 0 {
                         return Err(format!(
                             "relative {what} index {x} reaches before the first (only {} defined)",
                             now[k]
-                        ));
+                        )
+                        .into());
                     }
                     r
                 } else {
-                    return Err(format!("{what} index 0 (OBJ indices start at 1)"));
+                    return Err(format!("{what} index 0 (OBJ indices start at 1)").into());
                 };
                 if idx >= MISSING as i64 {
-                    return Err(format!("{what} index {x} is too large"));
+                    return Err(format!("{what} index {x} is too large").into());
                 }
-                if idx as u64 >= now[k] {
+                if now.is_some_and(|now| idx as u64 >= now[k]) {
                     pending.push(Forward { attr: k as u8, index: idx as u32, line });
                 }
                 c[k] = idx as u32;
@@ -553,8 +553,17 @@ impl Piece {
     /// A polygon's triangles, fanned from its first corner (at least three corners).
     #[inline]
     fn fan(&mut self, corners: &[Corner]) {
-        let has_t = corners.iter().any(|c| c[1] != MISSING);
-        let has_n = corners.iter().any(|c| c[2] != MISSING);
+        // The face's largest index of each kind, plus one: 0 when no corner names that kind.
+        let mut top = [0u32; 3];
+        for c in corners {
+            for (m, x) in top.iter_mut().zip(c) {
+                *m = (*m).max(x.wrapping_add(1));
+            }
+        }
+        for (m, x) in self.max.iter_mut().zip(top) {
+            *m = (*m).max(x);
+        }
+        let (has_t, has_n) = (top[1] > 0, top[2] > 0);
         if has_t && !self.any_t {
             self.any_t = true;
             self.tt.resize(self.tv.len(), [MISSING; 3]);

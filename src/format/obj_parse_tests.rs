@@ -130,6 +130,11 @@ fn floats_are_exactly_what_str_parse_gives() {
         let want = t.parse::<f32>().ok();
         let got = parse_f32(t.as_bytes());
         assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "{t}");
+        for end in [" 0000000000\n", "\r\nv 1 2 3\n", "x1234567890"] {
+            let line = format!("{t}{end}");
+            let want = if end.starts_with('x') { None } else { want.map(|w| (w.to_bits(), t.len())) };
+            assert_eq!(lead_f32(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want, "{line}");
+        }
     }
     // Every f32 midpoint neighbourhood and random decimals of every length.
     let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
@@ -141,7 +146,11 @@ fn floats_are_exactly_what_str_parse_gives() {
         let mid = (f as f64 + f32::from_bits(f.to_bits() + 1) as f64) / 2.0;
         let digits = (x >> 40) as usize % 12 + 1;
         for t in [format!("{f}"), format!("{mid:e}"), format!("{:.*e}", digits, mid), format!("{:.*}", digits, f)] {
-            assert_eq!(parse_f32(t.as_bytes()).map(f32::to_bits), t.parse::<f32>().ok().map(f32::to_bits), "{t}");
+            let want = t.parse::<f32>().ok().map(f32::to_bits);
+            assert_eq!(parse_f32(t.as_bytes()).map(f32::to_bits), want, "{t}");
+            // Followed by more of the line, the digits are read eight at a time.
+            let line = format!("{t} 12345678 9\n");
+            assert_eq!(lead_f32(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want.map(|w| (w, t.len())), "{t}");
         }
     }
 }
@@ -161,15 +170,46 @@ fn any_piece_size_gives_the_same_result() {
     let whole = parse(&s);
     assert!(whole.tri_v.len() > 60);
     for piece in [1, 2, 3, 5, 7, 16, 64, 1000] {
-        let d = parse_reader(Path::new("t.obj"), s.as_bytes(), piece).unwrap();
-        assert_eq!(d, whole, "piece {piece}");
+        assert_eq!(pieces(&s, piece).unwrap(), whole, "piece {piece}");
     }
-    // Errors keep their line numbers too.
-    let bad = format!("{s}f 1 2 999\n");
-    let lines = bad.lines().count();
-    for piece in [1, 3, 64, 1 << 20] {
-        let e = parse_reader(Path::new("t.obj"), bad.as_bytes(), piece).unwrap_err().to_string();
-        assert!(e.contains(&format!("line {lines}:")), "{e}");
+    // Errors keep their line numbers too: one at the end, a relative index reaching before the
+    // first in the middle, and one past the file's end in a face before the last `v`.
+    let lines = s.lines().count();
+    let bad = [
+        (format!("{s}f 1 2 999\n"), lines + 1),
+        (format!("v 0 0 0\n{s}f 1 -999 2\n{s}"), lines + 2),
+        (format!("{s}f 1 2 999\n{s}"), lines + 1),
+    ];
+    for (bad, line) in &bad {
+        for piece in [1, 3, 64, 1 << 20] {
+            let e = pieces(bad, piece).unwrap_err();
+            assert!(e.contains(&format!("line {line}:")), "{e}");
+        }
+    }
+}
+
+/// `s` parsed with pieces of about `piece` bytes, both from memory and through a reader.
+fn pieces(s: &str, piece: usize) -> std::result::Result<ObjData, String> {
+    let path = Path::new("t.obj");
+    let mapped = parse_pieces::<true>(path, s.as_bytes(), piece, &Reporter::none()).map_err(|e| e.to_string());
+    let read = parse_reader(path, s.as_bytes(), piece).map_err(|e| e.to_string());
+    assert_eq!(mapped, read, "piece {piece}");
+    mapped
+}
+
+/// Pieces that need what comes before them (relative indices, faces naming vertices further
+/// down) read as the whole file does, for every piece size.
+#[test]
+fn pieces_that_need_their_base_read_as_the_whole() {
+    let mut s = String::from("f 3 2 1\n");
+    for i in 0..30 {
+        s += &format!("v {i} 0 0\nvn 0 0 1\nvt {i} 1\n");
+        s += if i % 4 == 3 { "f 1/1/1 -1/-1/-1 -2/-2/-2\n" } else { "f 1 2 3 4 5 6 7\n" };
+    }
+    let whole = parse(&s);
+    assert_eq!(whole.tri_v[0], [2, 1, 0]);
+    for piece in [1, 4, 9, 30, 200] {
+        assert_eq!(pieces(&s, piece).unwrap(), whole, "piece {piece}");
     }
 }
 
@@ -235,8 +275,9 @@ fn fast_path_reads_as_the_general_path() {
         }
         // Pieces of 7 bytes cut lines everywhere; 4096 holds each file whole.
         for piece in [7, 1 << 12] {
-            let fast = parse_with::<true>(Path::new("t.obj"), s.as_bytes(), piece).map_err(|e| e.to_string());
-            let slow = parse_with::<false>(Path::new("t.obj"), s.as_bytes(), piece).map_err(|e| e.to_string());
+            let none = Reporter::none();
+            let fast = parse_pieces::<true>(Path::new("t.obj"), s.as_bytes(), piece, &none).map_err(|e| e.to_string());
+            let slow = parse_pieces::<false>(Path::new("t.obj"), s.as_bytes(), piece, &none).map_err(|e| e.to_string());
             assert_eq!(fast, slow, "file {file}, piece {piece}:\n{s}");
         }
     }
