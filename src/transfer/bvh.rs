@@ -307,14 +307,14 @@ fn halves(items: &[Item]) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
 }
 
 /// Each item's key (Morton code of its box's centre over the centres' bounds `c`, then its
-/// index), sorted: three stable passes of 12 bits over the code, from index order.
+/// index), sorted.
 fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
     use rayon::prelude::*;
     let n = items.len();
     let cells = (1u32 << AXIS_BITS) as f32;
     let extent = c.max - c.min;
     let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
-    let mut keys: Vec<u64> = items
+    let keys: Vec<u64> = items
         .par_iter()
         .enumerate()
         .map(|(i, it)| {
@@ -323,24 +323,31 @@ fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
             code << INDEX_BITS | i as u64
         })
         .collect();
-    let mut other = vec![0u64; n];
-    for pass in 0..3 {
-        let shift = INDEX_BITS + pass * AXIS_BITS;
-        let digit = |k: u64| ((k >> shift) as usize) & ((1 << AXIS_BITS) - 1);
-        let mut start = vec![0usize; 1 << AXIS_BITS];
-        keys.iter().for_each(|&k| start[digit(k)] += 1);
-        let mut sum = 0;
-        for s in start.iter_mut() {
-            (*s, sum) = (sum, sum + *s);
-        }
-        for &k in &keys {
-            let d = digit(k);
-            other[start[d]] = k;
-            start[d] += 1;
-        }
-        std::mem::swap(&mut keys, &mut other);
+    // One pass on the code's top 12 bits into buckets, then each bucket sorted on its own, on
+    // every core: the keys are unique, so any sort gives the one order.
+    let top = |k: u64| (k >> (INDEX_BITS + 2 * AXIS_BITS)) as usize;
+    let mut start = vec![0usize; (1 << AXIS_BITS) + 1];
+    keys.iter().for_each(|&k| start[top(k) + 1] += 1);
+    for d in 1..start.len() {
+        start[d] += start[d - 1];
     }
-    keys
+    let mut sorted = vec![0u64; n];
+    let mut next = start.clone();
+    for &k in &keys {
+        let d = top(k);
+        sorted[next[d]] = k;
+        next[d] += 1;
+    }
+    drop(keys);
+    let mut buckets: Vec<&mut [u64]> = Vec::with_capacity(1 << AXIS_BITS);
+    let mut rest = sorted.as_mut_slice();
+    for d in 0..1 << AXIS_BITS {
+        let (b, r) = rest.split_at_mut(start[d + 1] - start[d]);
+        buckets.push(b);
+        rest = r;
+    }
+    buckets.into_par_iter().for_each(|b| b.sort_unstable());
+    sorted
 }
 
 /// The low 12 bits of `x`, two zero bits after each.
