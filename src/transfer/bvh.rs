@@ -6,7 +6,7 @@
 //! share) permuted into leaf order, so that a leaf's triangles sit together; HIGH's positions
 //! are needed only while it is built.
 
-use super::wide::{collapse, Wide};
+use super::wide::{Upper, Wide};
 use glam::Vec3A;
 
 /// One node: 32 bytes. An inner node's left child is the next node and `a` is its right child;
@@ -113,20 +113,19 @@ impl Bvh {
             })
             .collect();
         let bc = bounds_of(&items);
-        let nodes = if (MORTON_MIN..1 << INDEX_BITS).contains(&n) {
+        let upper = if (MORTON_MIN..1 << INDEX_BITS).contains(&n) {
             let mut keys = morton_keys(&items, &bc.1);
             items = keys.par_iter().map(|k| items[(k & INDEX_MASK) as usize]).collect();
             keys.iter_mut().for_each(|k| *k >>= INDEX_BITS);
-            build_morton(&mut items, &keys, 0).assemble()
+            build_morton(&mut items, &keys, 0)
         } else {
-            build_par(&mut items, 0, bc)
+            Upper::Range(build_par(&mut items, 0, bc))
         };
         // Each array is dropped as soon as the next is made from it: the build's peak is what
         // bounds memory on a large HIGH.
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         drop(items);
-        let wide = collapse(&nodes);
-        drop(nodes);
+        let wide = upper.collapse();
         let tris: Vec<[u32; 3]> = ids.par_iter().map(|&i| triangles[i as usize]).collect();
         drop(triangles);
         let corners = tris.par_iter().map(|t| t.map(|i| positions[i as usize])).collect();
@@ -360,65 +359,31 @@ fn spread(x: u64) -> u64 {
     x
 }
 
+fn upper_bounds(u: &Upper) -> Aabb {
+    let n = match u {
+        Upper::Range(nodes) => &nodes[0],
+        Upper::Split(n, ..) => n,
+    };
+    Aabb { min: Vec3A::from(n.min), max: Vec3A::from(n.max) }
+}
+
 /// The upper levels over Morton-sorted items: each split where the codes' highest differing
 /// bit flips; ranges of [`SAH_RANGE`] or fewer (or of one code) are built by binned SAH.
-enum Top {
-    Range(Vec<Node>),
-    Split(Aabb, Box<Top>, Box<Top>),
-}
-
-impl Top {
-    fn bounds(&self) -> Aabb {
-        match self {
-            Top::Range(nodes) => Aabb { min: Vec3A::from(nodes[0].min), max: Vec3A::from(nodes[0].max) },
-            Top::Split(b, ..) => *b,
-        }
-    }
-
-    fn len(&self) -> usize {
-        match self {
-            Top::Range(nodes) => nodes.len(),
-            Top::Split(_, l, r) => 1 + l.len() + r.len(),
-        }
-    }
-
-    /// The binary tree in one array, in the order [`build_par`] lays it out.
-    fn assemble(self) -> Vec<Node> {
-        fn put(t: Top, out: &mut Vec<Node>) {
-            match t {
-                Top::Range(nodes) => {
-                    let base = out.len() as u32;
-                    out.extend(nodes.iter().map(|n| if n.n == 0 { Node { a: n.a + base, ..*n } } else { *n }));
-                }
-                Top::Split(b, l, r) => {
-                    let me = out.len();
-                    out.push(Node { min: b.min.to_array(), a: 0, max: b.max.to_array(), n: 0 });
-                    put(*l, out);
-                    out[me].a = out.len() as u32;
-                    put(*r, out);
-                }
-            }
-        }
-        let mut out = Vec::with_capacity(self.len());
-        put(self, &mut out);
-        out
-    }
-}
-
-fn build_morton(items: &mut [Item], codes: &[u64], offset: usize) -> Top {
+fn build_morton(items: &mut [Item], codes: &[u64], offset: usize) -> Upper {
     let last = codes.len() - 1;
     if items.len() <= SAH_RANGE || codes[0] == codes[last] {
         let bc = bounds_of(items);
-        return Top::Range(build_par(items, offset, bc));
+        return Upper::Range(build_par(items, offset, bc));
     }
     let bit = 63 - (codes[0] ^ codes[last]).leading_zeros();
     let mid = codes.partition_point(|c| c >> bit & 1 == 0);
     let (l, r) = items.split_at_mut(mid);
     let (cl, cr) = codes.split_at(mid);
     let (left, right) = rayon::join(|| build_morton(l, cl, offset), || build_morton(r, cr, offset + mid));
-    let mut b = left.bounds();
-    b.join(&right.bounds());
-    Top::Split(b, Box::new(left), Box::new(right))
+    let mut b = upper_bounds(&left);
+    b.join(&upper_bounds(&right));
+    let node = Node { min: b.min.to_array(), a: 0, max: b.max.to_array(), n: 0 };
+    Upper::Split(node, Box::new(left), Box::new(right))
 }
 
 /// Builds the subtree over `items` (which start at `offset` in leaf order, with bounds and

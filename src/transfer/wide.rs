@@ -4,6 +4,7 @@
 
 use super::bvh::Node;
 use glam::Vec4;
+use rayon::prelude::*;
 
 /// One node: 128 bytes, two cache lines.
 #[derive(Debug, Clone, Copy)]
@@ -36,7 +37,7 @@ impl Wide {
 
 /// Collapses the binary tree `bin` (root at 0, left child next, as [`super::bvh`] builds it)
 /// into four-wide nodes, root at 0, each node before its children (depth first).
-pub fn collapse(bin: &[Node]) -> Vec<Wide> {
+fn collapse(bin: &[Node]) -> Vec<Wide> {
     let mut out = Vec::with_capacity(bin.len() / 3 + 1);
     if bin[0].n > 0 {
         // A tree that is one leaf: a root with that leaf as its only child.
@@ -92,6 +93,114 @@ fn node(bin: &[Node], b: usize, out: &mut Vec<Wide>) -> u32 {
             w.count[lane] = leaf_count(&bin[k]);
         } else {
             w.child[lane] = node(bin, k, out);
+        }
+    }
+    out[me] = w;
+    me as u32
+}
+
+/// The binary tree as the Morton build leaves it: splits over ranges, each range a binary tree
+/// of its own (root at 0, as [`collapse`] reads it). A split carries its box in a [`Node`].
+pub enum Upper {
+    Range(Vec<Node>),
+    Split(Node, Box<Upper>, Box<Upper>),
+}
+
+/// An [`Upper`] whose ranges are set aside, numbered in depth-first order.
+enum Shape {
+    Range(usize, Node),
+    Split(Node, Box<Shape>, Box<Shape>),
+}
+
+impl Shape {
+    fn node(&self) -> &Node {
+        match self {
+            Shape::Range(_, n) | Shape::Split(n, ..) => n,
+        }
+    }
+}
+
+impl Upper {
+    fn shape(self, ranges: &mut Vec<Vec<Node>>) -> Shape {
+        match self {
+            Upper::Range(nodes) => {
+                let root = nodes[0];
+                ranges.push(nodes);
+                Shape::Range(ranges.len() - 1, root)
+            }
+            Upper::Split(n, l, r) => {
+                let l = l.shape(ranges);
+                Shape::Split(n, Box::new(l), Box::new(r.shape(ranges)))
+            }
+        }
+    }
+
+    /// The four-wide tree, root at 0: the splits collapsed as [`collapse`] does (a range's
+    /// root is not opened into the node above it), then every range collapsed on its own, on
+    /// every core, and appended after them in order.
+    pub fn collapse(self) -> Vec<Wide> {
+        let mut ranges = Vec::new();
+        let shape = match self {
+            Upper::Range(nodes) => return collapse(&nodes),
+            split => split.shape(&mut ranges),
+        };
+        let (mut out, mut later) = (Vec::new(), Vec::new());
+        split_node(&shape, &mut out, &mut later);
+        let mut wides: Vec<Vec<Wide>> =
+            ranges.into_par_iter().map(|r| if r[0].n > 0 { Vec::new() } else { collapse(&r) }).collect();
+        let mut at = out.len();
+        let offsets: Vec<u32> = wides
+            .iter()
+            .map(|w| {
+                let o = at as u32;
+                at += w.len();
+                o
+            })
+            .collect();
+        for (me, lane, range) in later {
+            out[me].child[lane] = offsets[range];
+        }
+        wides.par_iter_mut().zip(&offsets).for_each(|(w, &o)| {
+            for n in w.iter_mut() {
+                for lane in (0..4).filter(|&k| n.lanes & (1 << k) != 0 && n.count[k] == 0) {
+                    n.child[lane] += o;
+                }
+            }
+        });
+        out.reserve_exact(at - out.len());
+        wides.iter().for_each(|w| out.extend_from_slice(w));
+        out
+    }
+}
+
+/// The wide node for split `s`, as [`node`] builds one; lanes whose child is a range's root
+/// (not a leaf) are listed in `later` as (node, lane, range) to be pointed at it once placed.
+fn split_node(s: &Shape, out: &mut Vec<Wide>, later: &mut Vec<(usize, usize, usize)>) -> u32 {
+    let Shape::Split(_, l, r) = s else { unreachable!("split_node is given splits") };
+    let mut kids: Vec<&Shape> = vec![l, r];
+    while kids.len() < 4 {
+        let mut pick: Option<(usize, f32)> = None;
+        for (i, k) in kids.iter().enumerate() {
+            if matches!(k, Shape::Split(..)) && pick.is_none_or(|(_, a)| area(k.node()) > a) {
+                pick = Some((i, area(k.node())));
+            }
+        }
+        let Some((i, _)) = pick else { break };
+        let Shape::Split(_, a, b) = kids[i] else { unreachable!("picked a split") };
+        kids.splice(i..=i, [&**a, &**b]);
+    }
+    let me = out.len();
+    out.push(Wide::empty());
+    let mut w = Wide::empty();
+    for (lane, k) in kids.iter().enumerate() {
+        w.set(lane, k.node());
+        match k {
+            Shape::Split(..) => w.child[lane] = split_node(k, out, later),
+            Shape::Range(_, root) if root.n > 0 => {
+                w.child[lane] = root.a;
+                w.count[lane] = leaf_count(root);
+            }
+            Shape::Range(range, _) => later.push((me, lane, *range)),
         }
     }
     out[me] = w;
