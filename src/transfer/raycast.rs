@@ -122,7 +122,7 @@ pub struct Stack(Vec<Todo>);
 ///
 /// A node's four slab tests are those of the binary tree, lane by lane, in the same arithmetic
 /// (and with the same NaN rule: `_mm_min_ps`/`_mm_max_ps` keep the second operand); children are
-/// visited nearest first. Which hit wins never depends on the order: see [`Hit::better_than`].
+/// visited nearest first. Which hit wins never depends on the order: see `Hit::better_than`.
 pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -> Option<Hit> {
     if bvh.is_empty() {
         return None;

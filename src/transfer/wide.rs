@@ -100,7 +100,7 @@ fn node(bin: &[Node], b: usize, out: &mut Vec<Wide>) -> u32 {
 }
 
 /// The binary tree as the Morton build leaves it: splits over ranges, each range a binary tree
-/// of its own (root at 0, as [`collapse`] reads it). A split carries its box in a [`Node`].
+/// of its own (root at 0, left child next). A split carries its box in a [`Node`].
 pub enum Upper {
     Range(Vec<Node>),
     Split(Node, Box<Upper>, Box<Upper>),
@@ -135,7 +135,7 @@ impl Upper {
         }
     }
 
-    /// The four-wide tree, root at 0: the splits collapsed as [`collapse`] does (a range's
+    /// The four-wide tree, root at 0: the splits collapsed as a binary tree is (a range's
     /// root is not opened into the node above it), then every range collapsed on its own, on
     /// every core, and appended after them in order.
     pub fn collapse(self) -> Vec<Wide> {
