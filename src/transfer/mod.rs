@@ -134,7 +134,7 @@ pub fn material_prims(scene: &Scene, m: usize) -> Vec<PrimRef> {
         .collect()
 }
 
-/// HIGH's triangles grouped for the rays of each LOW part: one BVH per set of HIGH parts, all
+/// HIGH's triangles grouped for the rays of each LOW part: one BVH per set of HIGH parts, each
 /// holding its triangles' corners in leaf order.
 struct Sets {
     bvhs: Vec<bvh::Bvh>,
