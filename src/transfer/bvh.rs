@@ -139,8 +139,8 @@ impl Bvh {
 
     /// The corners of leaf-order triangle `k`.
     #[inline]
-    pub fn corners(&self, k: usize) -> [Vec3A; 3] {
-        self.corners[k].map(Vec3A::from)
+    pub fn corners(&self, k: usize) -> &[[f32; 3]; 3] {
+        &self.corners[k]
     }
 
     /// Bytes held, for the memory figures.
@@ -542,7 +542,7 @@ pub(crate) mod tests {
                     let first = n.child[lane] as usize;
                     for k in first..first + n.count[lane] as usize {
                         seen[b.ids[k] as usize] += 1;
-                        b.corners(k).iter().for_each(|&p| a.grow(p));
+                        b.corners(k).iter().for_each(|&p| a.grow(p.into()));
                     }
                     a
                 } else {

@@ -15,6 +15,8 @@ pub struct Ray {
     pub dir: Vec3A,
     inv: Vec3A,
     k: [usize; 3],
+    /// The origin's coordinates in the order `k` (x, y, then the dominant axis).
+    o: [f32; 3],
     shear: [f32; 3],
 }
 
@@ -34,7 +36,8 @@ impl Ray {
             std::mem::swap(&mut kx, &mut ky);
         }
         let shear = [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]];
-        Ray { origin, dir, inv: dir.recip(), k: [kx, ky, kz], shear }
+        let o = [origin[kx], origin[ky], origin[kz]];
+        Ray { origin, dir, inv: dir.recip(), k: [kx, ky, kz], o, shear }
     }
 }
 
@@ -61,16 +64,21 @@ impl Hit {
 }
 
 /// The watertight test; hits from both sides count.
+///
+/// Corners are read by axis straight from `v` (`v[i][k]` is one load): a vector register indexed
+/// by a run-time axis goes through memory, and that store and reload cost more than the test.
 #[inline]
-pub fn intersect(ray: &Ray, v: &[Vec3A; 3]) -> Option<(f32, [f32; 3])> {
+pub fn intersect(ray: &Ray, v: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
     let [kx, ky, kz] = ray.k;
     let [sx, sy, sz] = ray.shear;
-    let a = v[0] - ray.origin;
-    let b = v[1] - ray.origin;
-    let c = v[2] - ray.origin;
-    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+    let [ox, oy, oz] = ray.o;
+    let sheared = |p: &[f32; 3]| {
+        let z = p[kz] - oz;
+        (p[kx] - ox - sx * z, p[ky] - oy - sy * z, z)
+    };
+    let (ax, ay, az) = sheared(&v[0]);
+    let (bx, by, bz) = sheared(&v[1]);
+    let (cx, cy, cz) = sheared(&v[2]);
     let mut u = cx * by - cy * bx;
     let mut v = ax * cy - ay * cx;
     let mut w = bx * ay - by * ax;
@@ -87,21 +95,9 @@ pub fn intersect(ray: &Ray, v: &[Vec3A; 3]) -> Option<(f32, [f32; 3])> {
     if det == 0.0 || !det.is_finite() {
         return None;
     }
-    let t = (u * sz * a[kz] + v * sz * b[kz] + w * sz * c[kz]) / det;
+    let t = (u * sz * az + v * sz * bz + w * sz * cz) / det;
     let inv = 1.0 / det;
     Some((t, [u * inv, v * inv, w * inv]))
-}
-
-/// How far the interval `[a, b]` is from 0.
-#[inline]
-fn gap(a: f32, b: f32) -> f32 {
-    if a > 0.0 {
-        a
-    } else if b < 0.0 {
-        -b
-    } else {
-        0.0
-    }
 }
 
 /// A node or a leaf still to visit, and how far its part of the ray lies from the origin: one
@@ -168,7 +164,7 @@ fn visit(
 ) -> Option<Todo> {
     if todo.count > 0 {
         for k in todo.child as usize..(todo.child + todo.count) as usize {
-            let Some((t, bary)) = intersect(ray, &bvh.corners(k)) else { continue };
+            let Some((t, bary)) = intersect(ray, bvh.corners(k)) else { continue };
             if t < *lo || t > *hi {
                 continue;
             }
@@ -196,33 +192,44 @@ fn visit(
     if mask == 0 {
         return None;
     }
-    // Sorted by gap, farthest first (ties: the lower lane last, so it is visited first, as the
-    // binary tree's left child was).
-    let (near, far) = (near.to_array(), far.to_array());
-    let mut kids = [Todo { child: 0, count: 0, gap: 0.0 }; 4];
+    // How far each child's part of the ray lies from the origin: `near` when it is ahead,
+    // `-far` when behind, else 0 (branch-free: the lanes in `mask` have `near <= far`).
+    let gaps = near.max(-far).max(Vec4::ZERO).to_array();
+    let kid = |lane: usize| Todo { child: n.child[lane], count: n.count[lane] as u32, gap: gaps[lane] };
+    // The nearest child is visited next (ties: the lower lane, as the binary tree's left child
+    // was); the others are pushed farthest first.
+    let first = mask.trailing_zeros() as usize;
+    mask &= mask - 1;
+    let mut next = kid(first);
+    if mask == 0 {
+        return Some(next);
+    }
+    let mut rest = [next; 3];
     let mut len = 0;
     while mask != 0 {
-        let lane = mask.trailing_zeros() as usize;
+        let mut k = kid(mask.trailing_zeros() as usize);
         mask &= mask - 1;
-        let kid = Todo { child: n.child[lane], count: n.count[lane] as u32, gap: gap(near[lane], far[lane]) };
+        if k.gap < next.gap {
+            std::mem::swap(&mut k, &mut next);
+        }
         let mut i = len;
-        while i > 0 && kids[i - 1].gap <= kid.gap {
-            kids[i] = kids[i - 1];
+        while i > 0 && rest[i - 1].gap <= k.gap {
+            rest[i] = rest[i - 1];
             i -= 1;
         }
-        kids[i] = kid;
+        rest[i] = k;
         len += 1;
     }
-    stack.extend_from_slice(&kids[..len - 1]);
-    Some(kids[len - 1])
+    stack.extend_from_slice(&rest[..len]);
+    Some(next)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn tri(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [Vec3A; 3] {
-        [a.into(), b.into(), c.into()]
+    fn tri(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [[f32; 3]; 3] {
+        [a, b, c]
     }
 
     #[test]
