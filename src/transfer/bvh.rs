@@ -23,7 +23,8 @@ pub struct Node {
 pub struct Bvh {
     /// The binary tree collapsed to four children a node, as the rays walk it.
     pub nodes: Vec<Wide>,
-    /// Corner indices into `positions`, in leaf order.
+    /// Corner indices of each leaf-order triangle: into the positions it was built from, or
+    /// into other corners' arrays after [`Bvh::index_normals`].
     pub tris: Vec<[u32; 3]>,
     /// Each leaf-order triangle's index in the input.
     pub ids: Vec<u32>,
@@ -130,6 +131,14 @@ impl Bvh {
         drop(triangles);
         let corners = tris.par_iter().map(|t| t.map(|i| positions[i as usize])).collect();
         Bvh { nodes: wide, tris, ids, corners }
+    }
+
+    /// Replaces [`Bvh::tris`] with `corners(id)` for each triangle: a mesh whose normals have
+    /// indices of their own (an OBJ's `vn`) has them read in leaf order, as the rays meet them,
+    /// not from an array in input order.
+    pub fn index_normals(&mut self, corners: impl Fn(u32) -> [u32; 3] + Sync) {
+        use rayon::prelude::*;
+        self.tris.par_iter_mut().zip(&self.ids).for_each(|(t, &i)| *t = corners(i));
     }
 
     /// An empty tree has no nodes.

@@ -135,20 +135,22 @@ pub fn material_prims(scene: &Scene, m: usize) -> Vec<PrimRef> {
 }
 
 /// HIGH's triangles grouped for the rays of each LOW part: one BVH per set of HIGH parts, each
-/// holding its triangles' corners in leaf order.
+/// holding its triangles' corners, and their normals' indices, in leaf order.
 struct Sets {
     bvhs: Vec<bvh::Bvh>,
-    /// Per set, the HIGH triangle of each BVH id (`None`: the ids are HIGH's own).
-    ids: Vec<Option<Vec<u32>>>,
 }
 
+/// The trees over `sets`; a tree's triangles then index `normal_triangles`' normals, if HIGH has
+/// its own normal indices (an OBJ's `vn`), else the normals that follow the positions.
 fn build_sets(
     positions: Vec<[f32; 3]>,
     mut triangles: Vec<[u32; 3]>,
+    normal_triangles: Option<Vec<[u32; 3]>>,
     parts: &[mesh::HighPart],
     sets: &[Vec<usize>],
 ) -> Sets {
     let mut bvhs: Vec<Option<bvh::Bvh>> = sets.iter().map(|_| None).collect();
+    // Per set, the HIGH triangle of each tree id (`None`: the ids are HIGH's own).
     let mut ids = Vec::new();
     for (k, set) in sets.iter().enumerate() {
         if set.len() == parts.len() {
@@ -166,7 +168,13 @@ fn build_sets(
             bvhs[k] = Some(bvh::Bvh::build(&positions, std::mem::take(&mut triangles)));
         }
     }
-    Sets { bvhs: bvhs.into_iter().map(|b| b.expect("every set built")).collect(), ids }
+    let mut bvhs: Vec<bvh::Bvh> = bvhs.into_iter().map(|b| b.expect("every set built")).collect();
+    if let Some(nt) = normal_triangles {
+        for (b, ids) in bvhs.iter_mut().zip(&ids) {
+            b.index_normals(|i| nt[ids.as_ref().map_or(i, |v| v[i as usize]) as usize]);
+        }
+    }
+    Sets { bvhs }
 }
 
 /// Bakes HIGH into LOW: one map per material in `materials`, over the triangle primitives that
@@ -188,12 +196,9 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
     let high_names: Vec<String> = high_parts.iter().map(|p| p.name.clone()).collect();
     let groups = parts::group(&low_names, &high_names, s.matching);
     let High { positions, triangles, normals, normal_triangles } = high;
-    let sets = t.time("bvh", || build_sets(positions, triangles, &high_parts, &groups.sets));
+    let sets = t.time("bvh", || build_sets(positions, triangles, normal_triangles, &high_parts, &groups.sets));
     crate::timings::mem_mark("transfer bvh");
-    let high_bytes = sets.bvhs.iter().map(|b| b.bytes()).sum::<usize>()
-        + sets.ids.iter().flatten().map(|v| v.capacity() * 4).sum::<usize>()
-        + normals.capacity() * 12
-        + normal_triangles.as_ref().map_or(0, |n| n.capacity() * 12);
+    let high_bytes = sets.bvhs.iter().map(|b| b.bytes()).sum::<usize>() + normals.capacity() * 12;
     let front = s.ray_front.unwrap_or(DEFAULT_REACH * diagonal);
     let back = s.ray_back.unwrap_or(DEFAULT_REACH * diagonal);
     let labels = files::unique_labels(scene, materials);
@@ -218,7 +223,6 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
             low_set: &groups.low_set,
             parts: low_names.len(),
             normals: &normals,
-            normal_triangles: normal_triangles.as_deref(),
             front,
             back,
         };
@@ -326,9 +330,8 @@ struct Ctx<'a> {
     /// Per LOW part, the set of HIGH parts its rays meet.
     low_set: &'a [usize],
     parts: usize,
+    /// HIGH's normals, which the trees' triangles index.
     normals: &'a [[f32; 3]],
-    /// `None`: normals follow the positions' indices.
-    normal_triangles: Option<&'a [[u32; 3]]>,
     front: f64,
     back: f64,
 }
@@ -511,11 +514,7 @@ impl Ctx<'_> {
             c.missed_rays += 1;
             return flat;
         };
-        let id = self.sets.ids[set].as_ref().map_or(hit.id, |v| v[hit.id as usize]);
-        let ni = match self.normal_triangles {
-            Some(nt) => nt[id as usize],
-            None => tree.tris[hit.slot as usize],
-        };
+        let ni = tree.tris[hit.slot as usize];
         let n = |k: usize| Vec3A::from(self.normals[ni[k] as usize]) * hit.bary[k];
         let hn = (n(0) + n(1) + n(2)).normalize_or_zero();
         let bit = nrm.cross(tan) * sign;
