@@ -23,14 +23,20 @@ pub struct Node {
 pub struct Bvh {
     /// The binary tree collapsed to four children a node, as the rays walk it.
     pub nodes: Vec<Wide>,
-    /// Corner indices of each leaf-order triangle: into the positions it was built from, or
-    /// into other corners' arrays after [`Bvh::index_normals`].
-    pub tris: Vec<[u32; 3]>,
     /// Each leaf-order triangle's index in the input.
     pub ids: Vec<u32>,
-    /// Each leaf-order triangle's corners: a leaf's triangles are read from one place, not
-    /// through their indices from positions scattered over the whole mesh.
-    corners: Vec<[[f32; 3]; 3]>,
+    /// The triangles in leaf order: a leaf's triangles are read from one place, not through
+    /// their indices from positions scattered over the whole mesh.
+    tris: Vec<Tri>,
+}
+
+/// A triangle as the rays read it: its corners, and beside them (in the cache line the test
+/// has just loaded) the corner indices its hit is shaded with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Tri {
+    corners: [[f32; 3]; 3],
+    /// Into the positions the tree was built from, or as [`Bvh::build_indexed`] was told.
+    index: [u32; 3],
 }
 
 const BINS: usize = 16;
@@ -100,10 +106,21 @@ impl Bvh {
     /// range). Every triangle is kept, degenerate ones too: the intersection test rejects them,
     /// and their ids stay aligned with the input.
     pub fn build(positions: &[[f32; 3]], triangles: Vec<[u32; 3]>) -> Bvh {
+        Bvh::build_indexed(positions, triangles, |_| None)
+    }
+
+    /// [`Bvh::build`], with each triangle's shading corners given by `index(id)` where it
+    /// gives some (a mesh whose normals have indices of their own, as an OBJ's `vn`), else its
+    /// position indices: they are read in leaf order, beside the corners.
+    pub fn build_indexed(
+        positions: &[[f32; 3]],
+        triangles: Vec<[u32; 3]>,
+        index: impl Fn(u32) -> Option<[u32; 3]> + Sync,
+    ) -> Bvh {
         use rayon::prelude::*;
         let n = triangles.len();
         if n == 0 {
-            return Bvh { nodes: Vec::new(), tris: Vec::new(), ids: Vec::new(), corners: Vec::new() };
+            return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
         }
         let mut items: Vec<Item> = (0..n)
             .into_par_iter()
@@ -120,25 +137,21 @@ impl Bvh {
             keys.iter_mut().for_each(|k| *k >>= INDEX_BITS);
             build_morton(&mut items, &keys, 0)
         } else {
-            Upper::Range(build_par(&mut items, 0, bc))
+            Upper::range(build_par(&mut items, 0, bc))
         };
         // Each array is dropped as soon as the next is made from it: the build's peak is what
         // bounds memory on a large HIGH.
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         drop(items);
         let wide = upper.collapse();
-        let tris: Vec<[u32; 3]> = ids.par_iter().map(|&i| triangles[i as usize]).collect();
-        drop(triangles);
-        let corners = tris.par_iter().map(|t| t.map(|i| positions[i as usize])).collect();
-        Bvh { nodes: wide, tris, ids, corners }
-    }
-
-    /// Replaces [`Bvh::tris`] with `corners(id)` for each triangle: a mesh whose normals have
-    /// indices of their own (an OBJ's `vn`) has them read in leaf order, as the rays meet them,
-    /// not from an array in input order.
-    pub fn index_normals(&mut self, corners: impl Fn(u32) -> [u32; 3] + Sync) {
-        use rayon::prelude::*;
-        self.tris.par_iter_mut().zip(&self.ids).for_each(|(t, &i)| *t = corners(i));
+        let tris = ids
+            .par_iter()
+            .map(|&i| {
+                let t = triangles[i as usize];
+                Tri { corners: t.map(|k| positions[k as usize]), index: index(i).unwrap_or(t) }
+            })
+            .collect();
+        Bvh { nodes: wide, ids, tris }
     }
 
     /// An empty tree has no nodes.
@@ -149,15 +162,20 @@ impl Bvh {
     /// The corners of leaf-order triangle `k`.
     #[inline]
     pub fn corners(&self, k: usize) -> &[[f32; 3]; 3] {
-        &self.corners[k]
+        &self.tris[k].corners
+    }
+
+    /// The corner indices of leaf-order triangle `k` (see [`Bvh::build_indexed`]).
+    #[inline]
+    pub fn index(&self, k: usize) -> [u32; 3] {
+        self.tris[k].index
     }
 
     /// Bytes held, for the memory figures.
     pub fn bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Wide>()
-            + self.tris.capacity() * 12
+            + self.tris.capacity() * std::mem::size_of::<Tri>()
             + self.ids.capacity() * 4
-            + self.corners.capacity() * 36
     }
 }
 
@@ -369,10 +387,7 @@ fn spread(x: u64) -> u64 {
 }
 
 fn upper_bounds(u: &Upper) -> Aabb {
-    let n = match u {
-        Upper::Range(nodes) => &nodes[0],
-        Upper::Split(n, ..) => n,
-    };
+    let n = u.node();
     Aabb { min: Vec3A::from(n.min), max: Vec3A::from(n.max) }
 }
 
@@ -382,7 +397,7 @@ fn build_morton(items: &mut [Item], codes: &[u64], offset: usize) -> Upper {
     let last = codes.len() - 1;
     if items.len() <= SAH_RANGE || codes[0] == codes[last] {
         let bc = bounds_of(items);
-        return Upper::Range(build_par(items, offset, bc));
+        return Upper::range(build_par(items, offset, bc));
     }
     let bit = 63 - (codes[0] ^ codes[last]).leading_zeros();
     let mid = codes.partition_point(|c| c >> bit & 1 == 0);

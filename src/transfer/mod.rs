@@ -150,31 +150,24 @@ fn build_sets(
     sets: &[Vec<usize>],
 ) -> Sets {
     let mut bvhs: Vec<Option<bvh::Bvh>> = sets.iter().map(|_| None).collect();
-    // Per set, the HIGH triangle of each tree id (`None`: the ids are HIGH's own).
-    let mut ids = Vec::new();
+    let nt = normal_triangles.as_deref();
     for (k, set) in sets.iter().enumerate() {
         if set.len() == parts.len() {
-            ids.push(None);
             continue;
         }
         let tris: Vec<u32> = set.iter().flat_map(|&k| parts[k].start..parts[k].end).collect();
         let sub: Vec<[u32; 3]> = tris.iter().map(|&t| triangles[t as usize]).collect();
-        bvhs[k] = Some(bvh::Bvh::build(&positions, sub));
-        ids.push(Some(tris));
+        let index = |i: u32| nt.map(|nt| nt[tris[i as usize] as usize]);
+        bvhs[k] = Some(bvh::Bvh::build_indexed(&positions, sub, index));
     }
     // Every HIGH part: the tree takes HIGH's triangles over (permuted into leaf order), no copy.
     for (k, set) in sets.iter().enumerate() {
         if set.len() == parts.len() {
-            bvhs[k] = Some(bvh::Bvh::build(&positions, std::mem::take(&mut triangles)));
+            let index = |i: u32| nt.map(|nt| nt[i as usize]);
+            bvhs[k] = Some(bvh::Bvh::build_indexed(&positions, std::mem::take(&mut triangles), index));
         }
     }
-    let mut bvhs: Vec<bvh::Bvh> = bvhs.into_iter().map(|b| b.expect("every set built")).collect();
-    if let Some(nt) = normal_triangles {
-        for (b, ids) in bvhs.iter_mut().zip(&ids) {
-            b.index_normals(|i| nt[ids.as_ref().map_or(i, |v| v[i as usize]) as usize]);
-        }
-    }
-    Sets { bvhs }
+    Sets { bvhs: bvhs.into_iter().map(|b| b.expect("every set built")).collect() }
 }
 
 /// Bakes HIGH into LOW: one map per material in `materials`, over the triangle primitives that
@@ -514,7 +507,7 @@ impl Ctx<'_> {
             c.missed_rays += 1;
             return flat;
         };
-        let ni = tree.tris[hit.slot as usize];
+        let ni = tree.index(hit.slot as usize);
         let n = |k: usize| Vec3A::from(self.normals[ni[k] as usize]) * hit.bary[k];
         let hn = (n(0) + n(1) + n(2)).normalize_or_zero();
         let bit = nrm.cross(tan) * sign;

@@ -38,18 +38,21 @@ impl Wide {
 /// Collapses the binary tree `bin` (root at 0, left child next, as [`super::bvh`] builds it)
 /// into four-wide nodes, root at 0, each node before its children (depth first).
 fn collapse(bin: &[Node]) -> Vec<Wide> {
-    let mut out = Vec::with_capacity(bin.len() / 3 + 1);
     if bin[0].n > 0 {
-        // A tree that is one leaf: a root with that leaf as its only child.
-        let mut w = Wide::empty();
-        w.set(0, &bin[0]);
-        w.child[0] = bin[0].a;
-        w.count[0] = leaf_count(&bin[0]);
-        out.push(w);
-    } else {
-        node(bin, 0, &mut out);
+        return lone_leaf(&bin[0]);
     }
+    let mut out = Vec::with_capacity(bin.len() / 3 + 1);
+    node(bin, 0, &mut out);
     out
+}
+
+/// A tree that is one leaf: a root with that leaf as its only child.
+fn lone_leaf(leaf: &Node) -> Vec<Wide> {
+    let mut w = Wide::empty();
+    w.set(0, leaf);
+    w.child[0] = leaf.a;
+    w.count[0] = leaf_count(leaf);
+    vec![w]
 }
 
 fn leaf_count(n: &Node) -> u8 {
@@ -99,10 +102,13 @@ fn node(bin: &[Node], b: usize, out: &mut Vec<Wide>) -> u32 {
     me as u32
 }
 
-/// The binary tree as the Morton build leaves it: splits over ranges, each range a binary tree
-/// of its own (root at 0, left child next). A split carries its box in a [`Node`].
+/// The tree as the Morton build leaves it: binary splits over ranges, each range collapsed to
+/// its own four-wide tree on the core that built it, while its nodes are still in cache. A
+/// split carries its box in a [`Node`].
 pub enum Upper {
-    Range(Vec<Node>),
+    /// A range's binary root (its box, or the leaf it is) and its four-wide tree (empty when
+    /// the root is a leaf).
+    Range(Node, Vec<Wide>),
     Split(Node, Box<Upper>, Box<Upper>),
 }
 
@@ -121,11 +127,23 @@ impl Shape {
 }
 
 impl Upper {
-    fn shape(self, ranges: &mut Vec<Vec<Node>>) -> Shape {
+    /// A range over the binary tree `bin` (root at 0).
+    pub fn range(bin: Vec<Node>) -> Upper {
+        let wide = if bin[0].n > 0 { Vec::new() } else { collapse(&bin) };
+        Upper::Range(bin[0], wide)
+    }
+
+    /// Its binary root's box.
+    pub fn node(&self) -> &Node {
         match self {
-            Upper::Range(nodes) => {
-                let root = nodes[0];
-                ranges.push(nodes);
+            Upper::Range(n, _) | Upper::Split(n, ..) => n,
+        }
+    }
+
+    fn shape(self, ranges: &mut Vec<Vec<Wide>>) -> Shape {
+        match self {
+            Upper::Range(root, wide) => {
+                ranges.push(wide);
                 Shape::Range(ranges.len() - 1, root)
             }
             Upper::Split(n, l, r) => {
@@ -136,20 +154,18 @@ impl Upper {
     }
 
     /// The four-wide tree, root at 0: the splits collapsed as a binary tree is (a range's
-    /// root is not opened into the node above it), then every range collapsed on its own, on
-    /// every core, and appended after them in order.
+    /// root is not opened into the node above it), then every range's tree appended in order.
     pub fn collapse(self) -> Vec<Wide> {
         let mut ranges = Vec::new();
         let shape = match self {
-            Upper::Range(nodes) => return collapse(&nodes),
+            Upper::Range(root, _) if root.n > 0 => return lone_leaf(&root),
+            Upper::Range(_, wide) => return wide,
             split => split.shape(&mut ranges),
         };
         let (mut out, mut later) = (Vec::new(), Vec::new());
         split_node(&shape, &mut out, &mut later);
-        let mut wides: Vec<Vec<Wide>> =
-            ranges.into_par_iter().map(|r| if r[0].n > 0 { Vec::new() } else { collapse(&r) }).collect();
         let mut at = out.len();
-        let offsets: Vec<u32> = wides
+        let offsets: Vec<u32> = ranges
             .iter()
             .map(|w| {
                 let o = at as u32;
@@ -160,7 +176,7 @@ impl Upper {
         for (me, lane, range) in later {
             out[me].child[lane] = offsets[range];
         }
-        wides.par_iter_mut().zip(&offsets).for_each(|(w, &o)| {
+        ranges.par_iter_mut().zip(&offsets).for_each(|(w, &o)| {
             for n in w.iter_mut() {
                 for lane in (0..4).filter(|&k| n.lanes & (1 << k) != 0 && n.count[k] == 0) {
                     n.child[lane] += o;
@@ -168,7 +184,7 @@ impl Upper {
             }
         });
         out.reserve_exact(at - out.len());
-        wides.iter().for_each(|w| out.extend_from_slice(w));
+        ranges.iter().for_each(|w| out.extend_from_slice(w));
         out
     }
 }
