@@ -19,6 +19,13 @@ pub struct Node {
     pub n: u32,
 }
 
+impl Node {
+    /// Half its box's surface area, as the build's cost model counts it.
+    pub fn area(&self) -> f32 {
+        Aabb { min: Vec3A::from(self.min), max: Vec3A::from(self.max) }.area()
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Bvh {
     /// The binary tree collapsed to four children a node, as the rays walk it.

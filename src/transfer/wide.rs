@@ -59,33 +59,37 @@ fn leaf_count(n: &Node) -> u8 {
     u8::try_from(n.n).expect("leaves hold at most 255 triangles")
 }
 
-fn area(n: &Node) -> f32 {
-    let d = [n.max[0] - n.min[0], n.max[1] - n.min[1], n.max[2] - n.min[2]];
-    d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+/// The children a wide node takes from a binary node whose children are `l` and `r`: the
+/// largest (by area) inner child opened into its own two children, in place, until four (or
+/// only leaves) remain. `inner` gives an inner child's area and children, `None` for a leaf.
+fn open<T: Copy>(l: T, r: T, inner: impl Fn(T) -> Option<(f32, T, T)>) -> ([T; 4], usize) {
+    let mut kids = [l, r, r, r];
+    let mut len = 2;
+    while len < 4 {
+        let mut pick: Option<(usize, f32, T, T)> = None;
+        for (i, &k) in kids[..len].iter().enumerate() {
+            if let Some((area, a, b)) = inner(k) {
+                if pick.is_none_or(|p| area > p.1) {
+                    pick = Some((i, area, a, b));
+                }
+            }
+        }
+        let Some((i, _, a, b)) = pick else { break };
+        // The opened child's two children take its place, in order, so the lanes stay in the
+        // binary tree's left-to-right order.
+        kids.copy_within(i + 1..len, i + 2);
+        kids[i] = a;
+        kids[i + 1] = b;
+        len += 1;
+    }
+    (kids, len)
 }
 
 /// The wide node for binary inner node `b`: its two children opened, then the largest inner
 /// child among them opened until four (or only leaves) remain; returns its index.
 fn node(bin: &[Node], b: usize, out: &mut Vec<Wide>) -> u32 {
-    let mut kids = [0usize; 4];
-    kids[..2].copy_from_slice(&[b + 1, bin[b].a as usize]);
-    let mut len = 2;
-    while len < 4 {
-        let mut pick: Option<(usize, f32)> = None;
-        for (i, &k) in kids[..len].iter().enumerate() {
-            if bin[k].n == 0 && pick.is_none_or(|(_, a)| area(&bin[k]) > a) {
-                pick = Some((i, area(&bin[k])));
-            }
-        }
-        let Some((i, _)) = pick else { break };
-        let k = kids[i];
-        // The opened child's two children take its place, in order, so the lanes stay in the
-        // binary tree's left-to-right order.
-        kids.copy_within(i + 1..len, i + 2);
-        kids[i] = k + 1;
-        kids[i + 1] = bin[k].a as usize;
-        len += 1;
-    }
+    let inner = |k: usize| (bin[k].n == 0).then(|| (bin[k].area(), k + 1, bin[k].a as usize));
+    let (kids, len) = open(b + 1, bin[b].a as usize, inner);
     let me = out.len();
     out.push(Wide::empty());
     let mut w = Wide::empty();
@@ -191,24 +195,17 @@ impl Upper {
 
 /// The wide node for split `s`, as [`node`] builds one; lanes whose child is a range's root
 /// (not a leaf) are listed in `later` as (node, lane, range) to be pointed at it once placed.
-fn split_node(s: &Shape, out: &mut Vec<Wide>, later: &mut Vec<(usize, usize, usize)>) -> u32 {
+fn split_node<'a>(s: &'a Shape, out: &mut Vec<Wide>, later: &mut Vec<(usize, usize, usize)>) -> u32 {
     let Shape::Split(_, l, r) = s else { unreachable!("split_node is given splits") };
-    let mut kids: Vec<&Shape> = vec![l, r];
-    while kids.len() < 4 {
-        let mut pick: Option<(usize, f32)> = None;
-        for (i, k) in kids.iter().enumerate() {
-            if matches!(k, Shape::Split(..)) && pick.is_none_or(|(_, a)| area(k.node()) > a) {
-                pick = Some((i, area(k.node())));
-            }
-        }
-        let Some((i, _)) = pick else { break };
-        let Shape::Split(_, a, b) = kids[i] else { unreachable!("picked a split") };
-        kids.splice(i..=i, [&**a, &**b]);
-    }
+    let inner = |k: &'a Shape| match k {
+        Shape::Split(n, a, b) => Some((n.area(), &**a, &**b)),
+        Shape::Range(..) => None,
+    };
+    let (kids, len) = open(&**l, &**r, inner);
     let me = out.len();
     out.push(Wide::empty());
     let mut w = Wide::empty();
-    for (lane, k) in kids.iter().enumerate() {
+    for (lane, k) in kids[..len].iter().enumerate() {
         w.set(lane, k.node());
         match k {
             Shape::Split(..) => w.child[lane] = split_node(k, out, later),
