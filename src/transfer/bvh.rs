@@ -476,15 +476,22 @@ fn build_small(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, b: Aabb
     let mut c = Aabb::EMPTY;
     items.iter().for_each(|it| c.grow(it.centre()));
     let axis = longest(c.max - c.min);
-    let key = |it: &Item| (it.centre()[axis], it.id);
-    // Insertion sort: a handful of items; `id` breaks ties so the order is the input's.
+    // Insertion sort of the keys, each computed once (a handful of items; `id` breaks ties so
+    // the order is the input's), then the items moved once.
+    let mut keys = [((0.0f32, 0u32), 0usize); SMALL];
+    for (i, (k, it)) in keys.iter_mut().zip(items.iter()).enumerate() {
+        *k = ((it.centre()[axis], it.id), i);
+    }
     for i in 1..n {
         let mut j = i;
-        while j > 0 && key(&items[j - 1]) > key(&items[j]) {
-            items.swap(j - 1, j);
+        while j > 0 && keys[j - 1].0 > keys[j].0 {
+            keys.swap(j - 1, j);
             j -= 1;
         }
     }
+    let mut was = [items[0]; SMALL];
+    was[..n].copy_from_slice(items);
+    items.iter_mut().zip(&keys).for_each(|(it, &(_, i))| *it = was[i]);
     let mut right = [(Aabb::EMPTY, 0.0f32); SMALL];
     let mut acc = Aabb::EMPTY;
     for k in (1..n).rev() {
