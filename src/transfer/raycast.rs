@@ -48,7 +48,7 @@ pub struct Hit {
     pub t: f32,
     /// The triangle's index in the input.
     pub id: u32,
-    /// Its index in the tree's leaf order (into [`Bvh::tris`]).
+    /// Its index in the tree's leaf order (for [`Bvh::corners`] and [`Bvh::index`]).
     pub slot: u32,
     /// Barycentric weights of the triangle's three corners.
     pub bary: [f32; 3],
