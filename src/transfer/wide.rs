@@ -4,7 +4,6 @@
 
 use super::bvh::Node;
 use glam::Vec4;
-use rayon::prelude::*;
 
 /// One node: 128 bytes, two cache lines.
 #[derive(Debug, Clone, Copy)]
@@ -116,20 +115,6 @@ pub enum Upper {
     Split(Node, Box<Upper>, Box<Upper>),
 }
 
-/// An [`Upper`] whose ranges are set aside, numbered in depth-first order.
-enum Shape {
-    Range(usize, Node),
-    Split(Node, Box<Shape>, Box<Shape>),
-}
-
-impl Shape {
-    fn node(&self) -> &Node {
-        match self {
-            Shape::Range(_, n) | Shape::Split(n, ..) => n,
-        }
-    }
-}
-
 impl Upper {
     /// A range over the binary tree `bin` (root at 0).
     pub fn range(bin: Vec<Node>) -> Upper {
@@ -144,62 +129,41 @@ impl Upper {
         }
     }
 
-    fn shape(self, ranges: &mut Vec<Vec<Wide>>) -> Shape {
-        match self {
-            Upper::Range(root, wide) => {
-                ranges.push(wide);
-                Shape::Range(ranges.len() - 1, root)
-            }
-            Upper::Split(n, l, r) => {
-                let l = l.shape(ranges);
-                Shape::Split(n, Box::new(l), Box::new(r.shape(ranges)))
-            }
-        }
-    }
-
     /// The four-wide tree, root at 0: the splits collapsed as a binary tree is (a range's
-    /// root is not opened into the node above it), then every range's tree appended in order.
+    /// root is not opened into the node above it), then every range's tree appended in the
+    /// order the splits meet them, its inner children shifted as it is copied.
     pub fn collapse(self) -> Vec<Wide> {
-        let mut ranges = Vec::new();
-        let shape = match self {
+        match self {
             Upper::Range(root, _) if root.n > 0 => return lone_leaf(&root),
             Upper::Range(_, wide) => return wide,
-            split => split.shape(&mut ranges),
-        };
-        let (mut out, mut later) = (Vec::new(), Vec::new());
-        split_node(&shape, &mut out, &mut later);
-        let mut at = out.len();
-        let offsets: Vec<u32> = ranges
-            .iter()
-            .map(|w| {
-                let o = at as u32;
-                at += w.len();
-                o
-            })
-            .collect();
-        for (me, lane, range) in later {
-            out[me].child[lane] = offsets[range];
+            Upper::Split(..) => {}
         }
-        ranges.par_iter_mut().zip(&offsets).for_each(|(w, &o)| {
-            for n in w.iter_mut() {
-                for lane in (0..4).filter(|&k| n.lanes & (1 << k) != 0 && n.count[k] == 0) {
-                    n.child[lane] += o;
+        let (mut out, mut later) = (Vec::new(), Vec::new());
+        split_node(&self, &mut out, &mut later);
+        out.reserve_exact(later.iter().map(|(_, _, w)| w.len()).sum());
+        for (me, lane, wide) in later {
+            let at = out.len() as u32;
+            out[me].child[lane] = at;
+            out.extend(wide.iter().map(|n| {
+                let mut n = *n;
+                for k in (0..4).filter(|&k| n.lanes & (1 << k) != 0 && n.count[k] == 0) {
+                    n.child[k] += at;
                 }
-            }
-        });
-        out.reserve_exact(at - out.len());
-        ranges.iter().for_each(|w| out.extend_from_slice(w));
+                n
+            }));
+        }
         out
     }
 }
 
 /// The wide node for split `s`, as [`node`] builds one; lanes whose child is a range's root
-/// (not a leaf) are listed in `later` as (node, lane, range) to be pointed at it once placed.
-fn split_node<'a>(s: &'a Shape, out: &mut Vec<Wide>, later: &mut Vec<(usize, usize, usize)>) -> u32 {
-    let Shape::Split(_, l, r) = s else { unreachable!("split_node is given splits") };
-    let inner = |k: &'a Shape| match k {
-        Shape::Split(n, a, b) => Some((n.area(), &**a, &**b)),
-        Shape::Range(..) => None,
+/// (not a leaf) are listed in `later` as (node, lane, the range's tree) to be pointed at it
+/// once placed.
+fn split_node<'a>(s: &'a Upper, out: &mut Vec<Wide>, later: &mut Vec<(usize, usize, &'a [Wide])>) -> u32 {
+    let Upper::Split(_, l, r) = s else { unreachable!("split_node is given splits") };
+    let inner = |k: &'a Upper| match k {
+        Upper::Split(n, a, b) => Some((n.area(), &**a, &**b)),
+        Upper::Range(..) => None,
     };
     let (kids, len) = open(&**l, &**r, inner);
     let me = out.len();
@@ -208,12 +172,12 @@ fn split_node<'a>(s: &'a Shape, out: &mut Vec<Wide>, later: &mut Vec<(usize, usi
     for (lane, k) in kids[..len].iter().enumerate() {
         w.set(lane, k.node());
         match k {
-            Shape::Split(..) => w.child[lane] = split_node(k, out, later),
-            Shape::Range(_, root) if root.n > 0 => {
+            Upper::Split(..) => w.child[lane] = split_node(k, out, later),
+            Upper::Range(root, _) if root.n > 0 => {
                 w.child[lane] = root.a;
                 w.count[lane] = leaf_count(root);
             }
-            Shape::Range(range, _) => later.push((me, lane, *range)),
+            Upper::Range(_, wide) => later.push((me, lane, wide)),
         }
     }
     out[me] = w;
