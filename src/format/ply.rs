@@ -8,8 +8,10 @@
 //! Every count is checked against the bytes that remain before anything is allocated, so a
 //! header that claims billions of vertices is an error, not an allocation.
 //! Texture v is kept as stored (up, as in OBJ); the glue converts it to glTF's convention.
+//! Binary `vertex` and `face` elements are read on every core ([`super::ply_binary`]).
 
 use super::obj_parse::parse_f32;
+use super::ply_binary as binary;
 use crate::error::{Error, Result};
 use std::path::Path;
 
@@ -32,7 +34,7 @@ enum Encoding {
 }
 
 #[derive(Clone, Copy, PartialEq, Debug)]
-enum Ty {
+pub(super) enum Ty {
     I8,
     U8,
     I16,
@@ -58,7 +60,7 @@ impl Ty {
         })
     }
 
-    fn size(self) -> usize {
+    pub(super) fn size(self) -> usize {
         match self {
             Ty::I8 | Ty::U8 => 1,
             Ty::I16 | Ty::U16 => 2,
@@ -68,22 +70,33 @@ impl Ty {
     }
 }
 
-struct Property {
+pub(super) struct Property {
     name: String,
-    ty: Ty,
+    pub(super) ty: Ty,
     /// The count type of a list property.
-    list: Option<Ty>,
+    pub(super) list: Option<Ty>,
 }
 
-struct Element {
+pub(super) struct Element {
     name: String,
-    count: u64,
-    props: Vec<Property>,
+    pub(super) count: u64,
+    pub(super) props: Vec<Property>,
 }
 
-/// Reads the PLY file at `path`.
+/// Reads the PLY file at `path`, through a memory map when it is a file (a scan's PLY is not
+/// copied whole into memory beside what is read from it).
 pub fn read_file(path: &Path) -> Result<PlyMesh> {
-    let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
+    let cannot = |e: std::io::Error| Error::input(path, format!("cannot read: {e}"));
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let meta = file.metadata().map_err(cannot)?;
+    if meta.is_file() && meta.len() > 0 {
+        // SAFETY: the map is only read. Like every reader that maps a file (the OBJ reader
+        // too), this trusts nothing to truncate the file while it is read.
+        if let Ok(map) = unsafe { memmap2::Mmap::map(&file) } {
+            return parse(path, &map);
+        }
+    }
+    let bytes = std::fs::read(path).map_err(cannot)?;
     parse(path, &bytes)
 }
 
@@ -123,6 +136,12 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                 el.count
             ))
         };
+        let out_of_range = |k: u64, v: i64, nv: u64| {
+            err(format!(
+                "face {} names vertex {v}, but there are {nv} vertices (indices start at 0): the file is damaged",
+                k + 1
+            ))
+        };
         let bad_value = |k: u64, p: &Property| {
             err(format!("'{}' record {}: property '{}' is not a number", el.name, k + 1, p.name))
         };
@@ -146,6 +165,24 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                         _ => None,
                     };
                 let n = el.count as usize;
+                if let (true, Some((cols, stride))) = (enc != Encoding::Ascii, binary::fixed_layout(el)) {
+                    let (b, big) = (&cur.b[cur.i..], enc == Encoding::Big);
+                    if n * stride > b.len() {
+                        return Err(truncated((b.len() / stride) as u64));
+                    }
+                    mesh.positions = binary::columns(b, n, stride, [cols[x], cols[y], cols[z]], big);
+                    if let Some(k) = binary::first_not_finite(&mesh.positions) {
+                        return Err(err(format!("vertex {} has a non-finite coordinate", k + 1)));
+                    }
+                    if let Some(c) = nrm {
+                        mesh.normals = binary::columns(b, n, stride, c.map(|j| cols[j]), big);
+                    }
+                    if let Some(c) = uv {
+                        mesh.uvs = binary::columns(b, n, stride, c.map(|j| cols[j]), big);
+                    }
+                    cur.i += n * stride;
+                    continue;
+                }
                 mesh.positions.reserve_exact(n);
                 if nrm.is_some() {
                     mesh.normals.reserve_exact(n);
@@ -184,7 +221,22 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                 if !have_vertices {
                     return Err(err("'face' comes before 'vertex': faces must follow their vertices".to_string()));
                 }
+                if matches!(el.props[list].ty, Ty::F32 | Ty::F64) {
+                    return Err(err(
+                        "the 'face' element's vertex indices are floats: they must be integers".to_string()
+                    ));
+                }
                 let nv = mesh.positions.len() as u64;
+                if enc != Encoding::Ascii {
+                    let (tris, used) =
+                        binary::faces(el, list, &cur.b[cur.i..], nv, enc == Encoding::Big).map_err(|f| match f {
+                            binary::Fault::Truncated(k) => truncated(k),
+                            binary::Fault::Index { face, v } => out_of_range(face, v, nv),
+                        })?;
+                    mesh.triangles = tris;
+                    cur.i += used;
+                    continue;
+                }
                 mesh.triangles.reserve(el.count as usize);
                 let mut idx: Vec<u32> = Vec::new();
                 for k in 0..el.count {
@@ -210,10 +262,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                         for _ in 0..count {
                             let v = cur.int(p.ty).map_err(|e| if e { bad_value(k, p) } else { truncated(k) })?;
                             if v < 0 || v as u64 >= nv {
-                                return Err(err(format!(
-                                    "face {} names vertex {v}, but there are {nv} vertices (indices start at 0): the file is damaged",
-                                    k + 1
-                                )));
+                                return Err(out_of_range(k, v, nv));
                             }
                             idx.push(v as u32);
                         }
@@ -274,8 +323,10 @@ fn header(b: &[u8]) -> std::result::Result<(Encoding, Vec<Element>, usize), Stri
                 let (Some(ct), Some(it)) = (Ty::parse(ct), Ty::parse(it)) else {
                     return Err(format!("line {n}: unknown property type in '{line}'"));
                 };
-                if matches!(ct, Ty::F32 | Ty::F64) || matches!(it, Ty::F32 | Ty::F64) {
-                    return Err(format!("line {n}: a list's count and items must be integers in '{line}'"));
+                // Items may be floats (MeshLab's per-corner `texcoord`); face indices are checked
+                // where the face list is chosen.
+                if matches!(ct, Ty::F32 | Ty::F64) {
+                    return Err(format!("line {n}: a list's count must be an integer in '{line}'"));
                 }
                 el.props.push(Property { name: name.to_string(), ty: it, list: Some(ct) });
             }

@@ -107,6 +107,11 @@ fn damage_is_a_clear_error() {
         ("ply\nelement vertex 0\nend_header\n", "no 'format' line"),
         ("ply\nformat ascii 1.0\nproperty float x\nend_header\n", "property before any element"),
         ("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n", "no x, y and z"),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
+             element face 0\nproperty list uchar float vertex_indices\nend_header\n0 0 0\n",
+            "vertex indices are floats",
+        ),
         ("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 a 2\n", "not a number"),
     ] {
         let e = read(header.as_bytes()).unwrap_err();
@@ -122,5 +127,84 @@ fn the_fuzz_seeds_read_as_one_quad() {
         let m = parse(&f, &std::fs::read(&f).unwrap()).unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [2, 1, 0]], "{enc}");
         assert_eq!((m.positions[2], m.normals[2], m.uvs[3]), ([1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0]), "{enc}");
+    }
+}
+
+/// A mesh of `faces` polygons of 3 to 6 corners (several of the binary reader's blocks), with a
+/// list and a scalar around the index list, in the given encoding.
+fn polygons(enc: &str, faces: usize) -> Vec<u8> {
+    let nv = 5000;
+    let mut out = format!(
+        "ply\nformat {enc} 1.0\nelement vertex {nv}\nproperty double x\nproperty float y\nproperty float z\n\
+         property short extra\nelement face {faces}\nproperty list uchar float texcoord\n\
+         property list uchar uint vertex_indices\nproperty ushort flags\nend_header\n"
+    )
+    .into_bytes();
+    let be = enc == "binary_big_endian";
+    let put = |out: &mut Vec<u8>, b: &[u8]| out.extend(b.iter().rev().filter(|_| be).chain(b.iter().filter(|_| !be)));
+    let mut seed = 7u64;
+    let mut next = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 33) as u32
+    };
+    for k in 0..nv {
+        let p = [k as f64 * 0.001, (k % 7) as f64, -(k as f64) / 3.0];
+        if enc == "ascii" {
+            out.extend(format!("{} {} {} 3\n", p[0], p[1] as f32, p[2] as f32).bytes());
+        } else {
+            put(&mut out, &p[0].to_le_bytes());
+            put(&mut out, &(p[1] as f32).to_le_bytes());
+            put(&mut out, &(p[2] as f32).to_le_bytes());
+            put(&mut out, &3i16.to_le_bytes());
+        }
+    }
+    for _ in 0..faces {
+        let n = 3 + next() % 4;
+        let idx: Vec<u32> = (0..n).map(|_| next() % nv).collect();
+        if enc == "ascii" {
+            let s: Vec<String> = idx.iter().map(|i| i.to_string()).collect();
+            out.extend(format!("1 0.5 {n} {} 9\n", s.join(" ")).bytes());
+            continue;
+        }
+        out.push(1);
+        put(&mut out, &0.5f32.to_le_bytes());
+        out.push(n as u8);
+        idx.iter().for_each(|i| put(&mut out, &i.to_le_bytes()));
+        put(&mut out, &9u16.to_le_bytes());
+    }
+    out
+}
+
+/// The binary reader reads faces block by block on every core and the ASCII one line by line:
+/// they must agree, and name the same first damaged record.
+#[test]
+fn parallel_binary_reads_as_ascii_does() {
+    let faces = 150_000;
+    let m = read(&polygons("ascii", faces)).unwrap();
+    assert!(m.triangles.len() > 2 * faces);
+    assert_eq!(m.positions[4999], [4.999, 1.0, -4999.0 / 3.0]);
+    for enc in ["binary_little_endian", "binary_big_endian"] {
+        let good = polygons(enc, faces);
+        assert_eq!(read(&good).unwrap(), m, "{enc}");
+        // Cut inside a late face: the error names it, as the sequential reader would.
+        let e = read(&good[..good.len() - 9]).unwrap_err();
+        assert!(e.contains(&format!("record {faces} of {faces}")) && e.contains("truncated"), "{enc}: {e}");
+        // A bad index in the second block comes before a cut in the third.
+        let mut bad = good[..good.len() - 9].to_vec();
+        let (mut at, mut k) = (good.windows(10).position(|w| w == b"end_header").unwrap() + 11 + 5000 * 18, 0);
+        while k < 100_000 {
+            at += 5;
+            let n = bad[at] as usize;
+            at += 1 + 4 * n + 2;
+            k += 1;
+        }
+        let first = at + 6;
+        bad[first..first + 4].copy_from_slice(&if enc == "binary_big_endian" {
+            9999u32.to_be_bytes()
+        } else {
+            9999u32.to_le_bytes()
+        });
+        let e = read(&bad).unwrap_err();
+        assert!(e.contains("face 100001 names vertex 9999, but there are 5000 vertices"), "{enc}: {e}");
     }
 }
