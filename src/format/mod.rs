@@ -16,6 +16,7 @@ mod obj_block;
 mod obj_fast;
 pub mod obj_parse;
 pub mod ply;
+mod ply_ascii;
 mod ply_binary;
 pub mod raw;
 pub mod uri;

@@ -8,9 +8,12 @@
 //! Every count is checked against the bytes that remain before anything is allocated, so a
 //! header that claims billions of vertices is an error, not an allocation.
 //! Texture v is kept as stored (up, as in OBJ); the glue converts it to glTF's convention.
-//! Binary `vertex` and `face` elements are read on every core ([`super::ply_binary`]).
+//! The `vertex` and `face` elements are read on every core: binary ones always
+//! ([`super::ply_binary`]), ASCII ones when each record is one line ([`super::ply_ascii`]; anything
+//! else is read here, record by record).
 
 use super::obj_parse::parse_f32;
+use super::ply_ascii as ascii;
 use super::ply_binary as binary;
 use crate::error::{Error, Result};
 use std::path::Path;
@@ -165,6 +168,14 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                         _ => None,
                     };
                 let n = el.count as usize;
+                if enc == Encoding::Ascii && el.props.iter().all(|p| p.list.is_none()) {
+                    let cols = ascii::Columns { xyz: [x, y, z], nrm, uv };
+                    if let Some(((p, nr, t), used)) = ascii::vertices(el, &cur.b[cur.i..], &cols) {
+                        (mesh.positions, mesh.normals, mesh.uvs) = (p, nr, t);
+                        cur.i += used;
+                        continue;
+                    }
+                }
                 if let (true, Some((cols, stride))) = (enc != Encoding::Ascii, binary::fixed_layout(el)) {
                     let (b, big) = (&cur.b[cur.i..], enc == Encoding::Big);
                     if n * stride > b.len() {
@@ -227,7 +238,13 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                     ));
                 }
                 let nv = mesh.positions.len() as u64;
-                if enc != Encoding::Ascii {
+                if enc == Encoding::Ascii {
+                    if let Some((tris, used)) = ascii::faces(el, list, &cur.b[cur.i..], nv) {
+                        mesh.triangles = tris;
+                        cur.i += used;
+                        continue;
+                    }
+                } else {
                     let (tris, used) =
                         binary::faces(el, list, &cur.b[cur.i..], nv, enc == Encoding::Big).map_err(|f| match f {
                             binary::Fault::Truncated(k) => truncated(k),

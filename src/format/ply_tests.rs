@@ -208,3 +208,26 @@ fn parallel_binary_reads_as_ascii_does() {
         assert!(e.contains("face 100001 names vertex 9999, but there are 5000 vertices"), "{enc}: {e}");
     }
 }
+
+/// One record a line is read on every core; a record over two lines is not, and the sequential
+/// reader reads it to the same mesh.
+#[test]
+fn ascii_lines_are_read_in_parallel_and_other_layouts_sequentially() {
+    use crate::format::ply_ascii;
+    let b = polygons("ascii", 150_000);
+    let (_, els, body) = header(&b).unwrap();
+    let cols = ply_ascii::Columns { xyz: [0, 1, 2], nrm: None, uv: None };
+    let ((p, n, uv), used) = ply_ascii::vertices(&els[0], &b[body..], &cols).expect("one vertex a line");
+    assert_eq!((p.len(), n.len(), uv.len()), (5000, 0, 0));
+    let (tris, end) = ply_ascii::faces(&els[1], 1, &b[body + used..], 5000).expect("one face a line");
+    assert_eq!(body + used + end, b.len());
+    let whole = read(&b).unwrap();
+    assert_eq!((&whole.positions, &whole.triangles), (&p, &tris));
+    // The first face's texture list ends its line: that face is now two lines.
+    let mut split = b.clone();
+    let at = body + used + "1 0.5".len();
+    assert_eq!(split[at], b' ');
+    split[at] = b'\n';
+    assert!(ply_ascii::faces(&els[1], 1, &split[body + used..], 5000).is_none());
+    assert_eq!(read(&split).unwrap(), whole);
+}
