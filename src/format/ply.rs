@@ -9,8 +9,8 @@
 //! header that claims billions of vertices is an error, not an allocation.
 //! Texture v is kept as stored (up, as in OBJ); the glue converts it to glTF's convention.
 //! The `vertex` and `face` elements are read on every core: binary ones always
-//! ([`super::ply_binary`]), ASCII ones when each record is one line ([`super::ply_ascii`]; anything
-//! else is read here, record by record).
+//! (`ply_binary.rs`), ASCII ones when each record is one line (`ply_ascii.rs`; anything else is
+//! read here, record by record).
 
 use super::obj_parse::parse_f32;
 use super::ply_ascii as ascii;
