@@ -111,3 +111,13 @@ impl Scene {
         self.declared_primitive(r)
     }
 }
+
+/// The first vertex with a coordinate that is not finite, as an error naming `path` (every
+/// reader's words for it); on every core.
+fn check_finite(path: &Path, p: &[[f32; 3]]) -> Result<()> {
+    use rayon::prelude::*;
+    match p.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
+        Some(i) => Err(Error::input(path, format!("vertex {} has a non-finite coordinate", i + 1))),
+        None => Ok(()),
+    }
+}

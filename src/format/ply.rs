@@ -182,9 +182,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                         return Err(truncated((b.len() / stride) as u64));
                     }
                     mesh.positions = binary::columns(b, n, stride, [cols[x], cols[y], cols[z]], big);
-                    if let Some(k) = binary::first_not_finite(&mesh.positions) {
-                        return Err(err(format!("vertex {} has a non-finite coordinate", k + 1)));
-                    }
+                    super::check_finite(path, &mesh.positions)?;
                     if let Some(c) = nrm {
                         mesh.normals = binary::columns(b, n, stride, c.map(|j| cols[j]), big);
                     }
@@ -283,9 +281,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                             }
                             idx.push(v as u32);
                         }
-                        for w in idx.get(1..).unwrap_or(&[]).windows(2) {
-                            mesh.triangles.push([idx[0], w[0], w[1]]);
-                        }
+                        mesh.triangles.extend(fan(&idx));
                     }
                 }
             }
@@ -305,6 +301,11 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
         return Err(err("has no 'vertex' element".to_string()));
     }
     Ok(mesh)
+}
+
+/// A polygon's triangles, fanned from its first corner as OBJ faces are (none under three).
+pub(super) fn fan<T: Copy>(idx: &[T]) -> impl Iterator<Item = [T; 3]> + '_ {
+    idx.get(1..).unwrap_or(&[]).windows(2).map(|w| [idx[0], w[0], w[1]])
 }
 
 /// The encoding, the elements and where the body starts.
@@ -369,24 +370,14 @@ struct Cursor<'a> {
 impl Cursor<'_> {
     /// The next ASCII token; `None` at the end.
     fn token(&mut self) -> Option<&[u8]> {
-        while self.i < self.b.len() && self.b[self.i].is_ascii_whitespace() {
-            self.i += 1;
-        }
-        let s = self.i;
-        while self.i < self.b.len() && !self.b[self.i].is_ascii_whitespace() {
-            self.i += 1;
-        }
-        (self.i > s).then(|| &self.b[s..self.i])
+        ascii::next_token(self.b, &mut self.i)
     }
 
-    fn bytes<const N: usize>(&mut self) -> Option<[u8; N]> {
-        let s = self.b.get(self.i..self.i + N)?;
-        self.i += N;
-        let mut a: [u8; N] = s.try_into().ok()?;
-        if self.enc == Encoding::Big {
-            a.reverse();
-        }
-        Some(a)
+    /// The next binary value's bytes; `None` at the end.
+    fn value(&mut self, ty: Ty) -> Option<&[u8]> {
+        let s = self.b.get(self.i..self.i + ty.size())?;
+        self.i += ty.size();
+        Some(s)
     }
 
     /// A value as f32 (a double rounded once). Err(true): not a number, Err(false): the end.
@@ -395,30 +386,21 @@ impl Cursor<'_> {
             let t = self.token().ok_or(false)?;
             return parse_f32(t).ok_or(true);
         }
-        let e = false;
-        Ok(match ty {
-            Ty::F32 => f32::from_le_bytes(self.bytes().ok_or(e)?),
-            Ty::F64 => f64::from_le_bytes(self.bytes().ok_or(e)?) as f32,
-            _ => self.int(ty)? as f32,
-        })
+        let big = self.enc == Encoding::Big;
+        Ok(binary::float(self.value(ty).ok_or(false)?, ty, big))
     }
 
     /// An integer value (floats are refused where integers are needed).
     fn int(&mut self, ty: Ty) -> std::result::Result<i64, bool> {
         if self.enc == Encoding::Ascii {
             let t = self.token().ok_or(false)?;
-            return std::str::from_utf8(t).ok().and_then(|s| s.parse::<i64>().ok()).ok_or(true);
+            return ascii::int(t).ok_or(true);
         }
-        let e = false;
-        Ok(match ty {
-            Ty::I8 => i8::from_le_bytes(self.bytes().ok_or(e)?) as i64,
-            Ty::U8 => self.bytes::<1>().ok_or(e)?[0] as i64,
-            Ty::I16 => i16::from_le_bytes(self.bytes().ok_or(e)?) as i64,
-            Ty::U16 => u16::from_le_bytes(self.bytes().ok_or(e)?) as i64,
-            Ty::I32 => i32::from_le_bytes(self.bytes().ok_or(e)?) as i64,
-            Ty::U32 => u32::from_le_bytes(self.bytes().ok_or(e)?) as i64,
-            Ty::F32 | Ty::F64 => return Err(true),
-        })
+        if matches!(ty, Ty::F32 | Ty::F64) {
+            return Err(true);
+        }
+        let big = self.enc == Encoding::Big;
+        Ok(binary::int(self.value(ty).ok_or(false)?, ty, big))
     }
 
     fn skip(&mut self, ty: Ty) -> Option<()> {

@@ -8,7 +8,7 @@
 //! it give up, and the sequential reader reads the element again and names the first bad record.
 
 use super::obj_parse::parse_f32;
-use super::ply::Element;
+use super::ply::{fan, Element};
 use memchr::{memchr, memchr_iter};
 use rayon::prelude::*;
 
@@ -68,16 +68,21 @@ impl<'a> Iterator for Tokens<'a> {
 
     #[inline]
     fn next(&mut self) -> Option<&'a [u8]> {
-        let b = self.b;
-        while self.i < b.len() && b[self.i].is_ascii_whitespace() {
-            self.i += 1;
-        }
-        let start = self.i;
-        while self.i < b.len() && !b[self.i].is_ascii_whitespace() {
-            self.i += 1;
-        }
-        (self.i > start).then(|| &b[start..self.i])
+        next_token(self.b, &mut self.i)
     }
+}
+
+/// The token at or after `b[*i]`, with `*i` moved past it; `None` at the end.
+#[inline]
+pub(super) fn next_token<'a>(b: &'a [u8], i: &mut usize) -> Option<&'a [u8]> {
+    while *i < b.len() && b[*i].is_ascii_whitespace() {
+        *i += 1;
+    }
+    let start = *i;
+    while *i < b.len() && !b[*i].is_ascii_whitespace() {
+        *i += 1;
+    }
+    (*i > start).then(|| &b[start..*i])
 }
 
 fn tokens(line: &[u8]) -> Tokens<'_> {
@@ -96,7 +101,7 @@ fn lines(piece: &[u8]) -> impl Iterator<Item = &[u8]> {
 
 /// An integer as `str::parse::<i64>` reads it (sign, then digits), without its UTF-8 check.
 #[inline]
-fn int(t: &[u8]) -> Option<i64> {
+pub(super) fn int(t: &[u8]) -> Option<i64> {
     let (neg, digits) = match t.first()? {
         b'-' => (true, &t[1..]),
         b'+' => (false, &t[1..]),
@@ -200,9 +205,7 @@ pub(super) fn faces(el: &Element, list: usize, b: &[u8], nv: u64) -> Option<(Vec
                     }
                     idx.push(v as u32);
                 }
-                for w in idx.get(1..).unwrap_or(&[]).windows(2) {
-                    out.push([idx[0], w[0], w[1]]);
-                }
+                out.extend(fan(&idx));
             }
             if t.next().is_some() {
                 return None;

@@ -7,7 +7,7 @@
 //! come before it; then the blocks are read in parallel, each into its own part of the output.
 //! Errors are those of the sequential reader, for the same first record.
 
-use super::ply::{Element, Ty};
+use super::ply::{fan, Element, Ty};
 use rayon::prelude::*;
 
 /// Faces a parallel task reads.
@@ -36,7 +36,7 @@ fn get<const N: usize>(b: &[u8], big: bool) -> [u8; N] {
 /// An integer at the start of `b` (list counts and indices are integers: the header reader
 /// refuses others; a float here reads as its integer part).
 #[inline(always)]
-fn int(b: &[u8], ty: Ty, big: bool) -> i64 {
+pub(super) fn int(b: &[u8], ty: Ty, big: bool) -> i64 {
     match ty {
         Ty::I8 => b[0] as i8 as i64,
         Ty::U8 => b[0] as i64,
@@ -51,7 +51,7 @@ fn int(b: &[u8], ty: Ty, big: bool) -> i64 {
 
 /// A value at the start of `b` as f32, as the sequential reader gives it (a double rounded once).
 #[inline(always)]
-fn float(b: &[u8], ty: Ty, big: bool) -> f32 {
+pub(super) fn float(b: &[u8], ty: Ty, big: bool) -> f32 {
     match ty {
         Ty::F32 => f32::from_le_bytes(get(b, big)),
         Ty::F64 => f64::from_le_bytes(get(b, big)) as f32,
@@ -89,11 +89,6 @@ pub(super) fn columns<const N: usize>(
         return rows.map(|k| want.map(|(off, _)| f32::from_le_bytes(get(&b[k * stride + off..], big)))).collect();
     }
     rows.map(|k| want.map(|(off, ty)| float(&b[k * stride + off..], ty, big))).collect()
-}
-
-/// The first vertex (from 0) with a coordinate that is not finite.
-pub(super) fn first_not_finite(p: &[[f32; 3]]) -> Option<u64> {
-    p.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())).map(|k| k as u64)
 }
 
 /// Reads the face element `el` at the start of `b`, whose index list is property `list`, with
@@ -146,8 +141,8 @@ pub(super) fn faces(el: &Element, list: usize, b: &[u8], nv: u64, big: bool) -> 
             if let Some(&v) = idx.iter().find(|&&v| v < 0 || v as u64 >= nv) {
                 return Err(Fault::Index { face: k, v });
             }
-            for w in idx.get(1..).unwrap_or(&[]).windows(2) {
-                part[t] = [idx[0] as u32, w[0] as u32, w[1] as u32];
+            for tri in fan(&idx) {
+                part[t] = tri.map(|v| v as u32);
                 t += 1;
             }
         }

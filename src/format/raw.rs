@@ -6,6 +6,7 @@
 //! maps. Positions are in the mesh's world space: glTF node transforms are applied here (OBJ and
 //! PLY have none), normals through the normal matrix. UVs are in glTF's convention (v down).
 
+use super::check_finite;
 use super::obj_parse::{ObjData, Statement, MISSING};
 use super::ply::PlyMesh;
 use crate::error::{Error, Result};
@@ -128,13 +129,6 @@ pub fn from_ply(path: &Path, p: PlyMesh) -> Result<RawMesh> {
 fn flip_v(mut uvs: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
     uvs.par_iter_mut().for_each(|uv| uv[1] = 1.0 - uv[1]);
     uvs
-}
-
-fn check_finite(path: &Path, p: &[[f32; 3]]) -> Result<()> {
-    match p.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
-        Some(i) => Err(Error::input(path, format!("vertex {} has a non-finite coordinate", i + 1))),
-        None => Ok(()),
-    }
 }
 
 fn check_finite_uv(path: &Path, uv: &[[f32; 2]]) -> Result<()> {
