@@ -231,3 +231,24 @@ fn ascii_lines_are_read_in_parallel_and_other_layouts_sequentially() {
     assert!(ply_ascii::faces(&els[1], 1, &split[body + used..], 5000).is_none());
     assert_eq!(read(&split).unwrap(), whole);
 }
+
+/// Blender's ASCII export of the scene fixture's HIGH (`fixtures/blender_scene/make.py`) is read
+/// on every core, to the faces of its binary export and the same vertices within the text's
+/// rounding (Blender writes about eight significant digits).
+#[test]
+fn blenders_ascii_ply_reads_in_parallel_as_its_binary_ply() {
+    use crate::format::ply_ascii;
+    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/blender_scene/moved");
+    let text = std::fs::read(d.join("torus_high_ascii.ply")).unwrap();
+    let (_, els, body) = header(&text).unwrap();
+    let cols = ply_ascii::Columns { xyz: [0, 1, 2], nrm: Some([3, 4, 5]), uv: None };
+    let (_, used) = ply_ascii::vertices(&els[0], &text[body..], &cols).expect("a vertex a line");
+    ply_ascii::faces(&els[1], 0, &text[body + used..], els[0].count).expect("a face a line");
+    let a = read(&text).unwrap();
+    let b = read(&std::fs::read(d.join("torus_high.ply")).unwrap()).unwrap();
+    assert_eq!((a.triangles.len(), &a.triangles), (9216, &b.triangles));
+    let near =
+        |x: &[[f32; 3]], y: &[[f32; 3]]| x.iter().flatten().zip(y.iter().flatten()).all(|(p, q)| (p - q).abs() < 1e-5);
+    assert!(near(&a.positions, &b.positions) && near(&a.normals, &b.normals));
+    assert_eq!(a.positions.len(), b.positions.len());
+}
