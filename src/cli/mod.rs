@@ -48,6 +48,13 @@ pub enum Command {
 }
 
 /// Runs one parsed command line and returns the process exit code.
+impl Cli {
+    /// Whether this run bakes from HIGH meshes (`bake --from`).
+    pub fn bakes_from_high(&self) -> bool {
+        matches!(&self.command, Command::Bake(a) if !a.from.is_empty())
+    }
+}
+
 pub fn run(cli: Cli) -> Result<u8> {
     match cli.command {
         Command::Tangents(a) => tangents::run(a),

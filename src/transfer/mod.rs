@@ -414,7 +414,6 @@ impl Ctx<'_> {
         let samples = raster::band(edges, cand, y0, y1, w, n);
         c.overlapping_samples = samples.overlapping;
         let sw = w * n;
-        let mut sums = vec![Vec3A::ZERO; out.len()];
         let mut stack = raycast::Stack::default();
         // Square tiles of BAND x BAND texels, one after another: neighbouring rays meet the same
         // part of HIGH's tree while it is still in cache. Each texel's samples keep their order
@@ -442,7 +441,8 @@ impl Ctx<'_> {
             }
             o.state = o.state.max(if samples.inside(s) { 2 } else { 1 });
             o.samples += 1;
-            sums[texel] += r.ts;
+            // The samples' sum, normalised below.
+            o.normal = (Vec3A::from(o.normal) + r.ts).to_array();
             match r.t {
                 Some(d) => {
                     o.height += d;
@@ -455,9 +455,9 @@ impl Ctx<'_> {
                 }
             }
         }
-        for (o, s) in out.iter_mut().zip(sums) {
+        for o in out.iter_mut() {
             if o.samples > 0 {
-                let v = s.normalize_or(Vec3A::Z);
+                let v = Vec3A::from(o.normal).normalize_or(Vec3A::Z);
                 o.normal = v.to_array();
                 if o.hits > 0 {
                     o.height /= o.hits as f32;
