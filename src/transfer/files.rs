@@ -5,6 +5,7 @@ use super::{Settings, Texel};
 use crate::error::{Error, Result};
 use crate::normalmap::{self, Convention, Depth, NormalData, NormalImage, PngSettings};
 use crate::scene::Scene;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// A material's name as it can stand in a file name: letters, digits, `-` and `_`.
@@ -51,12 +52,19 @@ pub(super) fn encode(
     let img = |depth: Depth, dx: bool| {
         let ny = |v: f32| if dx { -v } else { v };
         let data = match depth {
-            Depth::Bits8 => {
-                NormalData::U8(n.iter().flat_map(|v| [v[0], ny(v[1]), v[2]].map(normalmap::quantize8)).collect())
-            }
-            Depth::Bits16 => {
-                NormalData::U16(n.iter().flat_map(|v| [v[0], ny(v[1]), v[2]].map(normalmap::quantize16)).collect())
-            }
+            // On every core: a 2048² map is 4M texels.
+            Depth::Bits8 => NormalData::U8(
+                n.par_iter()
+                    .map(|v| [v[0], ny(v[1]), v[2]].map(normalmap::quantize8))
+                    .collect::<Vec<_>>()
+                    .into_flattened(),
+            ),
+            Depth::Bits16 => NormalData::U16(
+                n.par_iter()
+                    .map(|v| [v[0], ny(v[1]), v[2]].map(normalmap::quantize16))
+                    .collect::<Vec<_>>()
+                    .into_flattened(),
+            ),
             Depth::Float => NormalData::F32(n.iter().flat_map(|v| [v[0], ny(v[1]), v[2]]).collect()),
         };
         NormalImage { width: w, height: h, channels: 3, data }

@@ -363,7 +363,8 @@ impl Ctx<'_> {
             let b1 = (e.max[1].max(0.0) as usize / BAND).min(bands - 1);
             (b0..=b1).for_each(|b| per_band[b].push(i as u32));
         }
-        let mut texels = vec![Texel::default(); w * h];
+        // Written on every core: each page is first touched, and faulted in, by one of them.
+        let mut texels: Vec<Texel> = (0..w * h).into_par_iter().map(|_| Texel::default()).collect();
         let band_counts: Vec<(Counts, Vec<PartStats>)> = texels
             .par_chunks_mut(BAND * w)
             .enumerate()
@@ -378,22 +379,7 @@ impl Ctx<'_> {
         let mut parts = vec![PartStats::default(); self.parts];
         for (b, ps) in band_counts {
             parts.iter_mut().zip(&ps).for_each(|(a, x)| a.add(x));
-            c.rays += b.rays;
-            c.missed_rays += b.missed_rays;
-            c.overlapping_samples += b.overlapping_samples;
-            c.clamped_below += b.clamped_below;
-            c.degenerate_frames += b.degenerate_frames;
-        }
-        for x in &texels {
-            match x.state {
-                2 => c.covered += 1,
-                1 => c.extended += 1,
-                _ => {}
-            }
-            c.texels_with_misses += (x.missed > 0) as usize;
-            if x.state > 0 {
-                parts[x.part as usize].texels += 1;
-            }
+            c.add(&b);
         }
         (texels, c, parts)
     }
@@ -455,7 +441,17 @@ impl Ctx<'_> {
                 }
             }
         }
+        // The band's texels are counted here, on the core that traced them.
         for o in out.iter_mut() {
+            match o.state {
+                2 => c.covered += 1,
+                1 => c.extended += 1,
+                _ => {}
+            }
+            c.texels_with_misses += (o.missed > 0) as usize;
+            if o.state > 0 {
+                parts[o.part as usize].texels += 1;
+            }
             if o.samples > 0 {
                 let v = Vec3A::from(o.normal).normalize_or(Vec3A::Z);
                 o.normal = v.to_array();

@@ -79,6 +79,7 @@ pub struct PartStats {
 
 impl PartStats {
     pub fn add(&mut self, o: &PartStats) {
+        self.texels += o.texels;
         self.rays += o.rays;
         self.missed_rays += o.missed_rays;
         self.distance_range = match (self.distance_range, o.distance_range) {

@@ -4,6 +4,7 @@
 
 use super::bvh::Node;
 use glam::Vec4;
+use rayon::prelude::*;
 
 /// One node: 128 bytes, two cache lines.
 #[derive(Debug, Clone, Copy)]
@@ -140,18 +141,27 @@ impl Upper {
         }
         let (mut out, mut later) = (Vec::new(), Vec::new());
         split_node(&self, &mut out, &mut later);
-        out.reserve_exact(later.iter().map(|(_, _, w)| w.len()).sum());
-        for (me, lane, wide) in later {
-            let at = out.len() as u32;
-            out[me].child[lane] = at;
-            out.extend(wide.iter().map(|n| {
-                let mut n = *n;
-                for k in (0..4).filter(|&k| n.lanes & (1 << k) != 0 && n.count[k] == 0) {
-                    n.child[k] += at;
-                }
-                n
-            }));
+        // Each range's tree goes after the upper nodes, in the order the splits met them; the
+        // copies (tens of MB at 10M triangles, every page of them new) run on every core.
+        let base = out.len();
+        let mut starts = Vec::with_capacity(later.len() + 1);
+        starts.push(0);
+        for &(me, lane, wide) in &later {
+            let start = *starts.last().expect("starts at 0");
+            out[me].child[lane] = (base + start) as u32;
+            starts.push(start + wide.len());
         }
+        let total = *starts.last().expect("starts at 0");
+        out.reserve_exact(total);
+        out.par_extend((0..total).into_par_iter().map(|i| {
+            let r = starts.partition_point(|&s| s <= i) - 1;
+            let mut n = later[r].2[i - starts[r]];
+            let at = (base + starts[r]) as u32;
+            for k in (0..4).filter(|&k| n.lanes & (1 << k) != 0 && n.count[k] == 0) {
+                n.child[k] += at;
+            }
+            n
+        }));
         out
     }
 }
