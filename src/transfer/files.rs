@@ -80,9 +80,10 @@ pub(super) fn encode(
                 .map_err(|e| Error::output(p, e))?;
         files.push((p.clone(), bytes));
     }
-    let hits: Vec<f32> = texels.iter().filter(|x| x.hits > 0).map(|x| x.height).collect();
-    let range = (!hits.is_empty()).then(|| {
-        [hits.iter().cloned().fold(f32::INFINITY, f32::min), hits.iter().cloned().fold(f32::NEG_INFINITY, f32::max)]
+    // One pass in texel order, without a copy of the heights (a zero's sign is kept as found).
+    let range = texels.iter().filter(|x| x.hits > 0).fold(None, |r: Option<[f32; 2]>, x| {
+        let [lo, hi] = r.unwrap_or([f32::INFINITY, f32::NEG_INFINITY]);
+        Some([lo.min(x.height), hi.max(x.height)])
     });
     if let Some(p) = &s.height_out {
         let [lo, hi] = range.unwrap_or([0.0, 0.0]);

@@ -222,8 +222,8 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
         let (texels, mut c, mut part_stats) = t.time("rays", || ctx.trace(s));
         crate::timings::mem_mark("transfer rays");
         let (w, h) = (s.width, s.height);
-        let mut n: Vec<[f32; 3]> = texels.iter().map(|x| x.normal).collect();
-        let mut filled: Vec<bool> = texels.iter().map(|x| x.state > 0).collect();
+        let mut n: Vec<[f32; 3]> = texels.par_iter().map(|x| x.normal).collect();
+        let mut filled: Vec<bool> = texels.par_iter().map(|x| x.state > 0).collect();
         c.padded = t.time("pad", || pad::pad(w, h, &mut n, &mut filled, s.padding));
         c.uncovered = filled.iter().filter(|&&f| !f).count();
         let mut sk = s.clone();
