@@ -47,7 +47,6 @@ pub enum Command {
     Preview(preview::Args),
 }
 
-/// Runs one parsed command line and returns the process exit code.
 impl Cli {
     /// Whether this run bakes from HIGH meshes (`bake --from`).
     pub fn bakes_from_high(&self) -> bool {
@@ -55,6 +54,7 @@ impl Cli {
     }
 }
 
+/// Runs one parsed command line and returns the process exit code.
 pub fn run(cli: Cli) -> Result<u8> {
     match cli.command {
         Command::Tangents(a) => tangents::run(a),
