@@ -121,3 +121,27 @@ fn check_finite(path: &Path, p: &[[f32; 3]]) -> Result<()> {
         None => Ok(()),
     }
 }
+
+/// A sign, then 1 to 18 decimal digits (so it never overflows), as `str::parse::<i64>` reads it
+/// without its UTF-8 check; `None` for anything else, a longer number included. The OBJ and ASCII
+/// PLY readers' one integer parser.
+#[inline]
+fn short_int(t: &[u8]) -> Option<i64> {
+    let (neg, digits) = match t.first()? {
+        b'-' => (true, &t[1..]),
+        b'+' => (false, &t[1..]),
+        _ => (false, t),
+    };
+    if digits.is_empty() || digits.len() > 18 {
+        return None;
+    }
+    let mut v = 0i64;
+    for &c in digits {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
+            return None;
+        }
+        v = v * 10 + d as i64;
+    }
+    Some(if neg { -v } else { v })
+}

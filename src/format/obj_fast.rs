@@ -89,25 +89,6 @@ pub(super) fn fast_corners(b: &[u8], mut i: usize, now: [u64; 3], corners: &mut 
     end_of_line(b, i)
 }
 
-pub(super) fn parse_int(t: &[u8]) -> Option<i64> {
-    let (neg, d) = match t.first()? {
-        b'-' => (true, &t[1..]),
-        b'+' => (false, &t[1..]),
-        _ => (false, t),
-    };
-    if d.is_empty() || d.len() > 18 {
-        return None;
-    }
-    let mut x: i64 = 0;
-    for &c in d {
-        if !c.is_ascii_digit() {
-            return None;
-        }
-        x = x * 10 + (c - b'0') as i64;
-    }
-    Some(if neg { -x } else { x })
-}
-
 /// The leading decimal digits of `b[i..]`, up to eight, read at once when eight bytes are there:
 /// how many there are (8 when there may be more) and their value.
 #[inline]

@@ -10,8 +10,9 @@
 //! `raw.rs` (a RawMesh) converts. Polygons are fanned from their first corner, as `tobj` did.
 
 use super::obj_block::Acc;
-use super::obj_fast::{fast_corners, fast_floats, parse_int};
+use super::obj_fast::{fast_corners, fast_floats};
 pub use super::obj_fast::{lead_f32, parse_f32};
+use super::short_int;
 use crate::error::{Error, Result};
 use crate::progress::{Counting, Reporter};
 use memchr::{memchr, memrchr};
@@ -512,7 +513,7 @@ impl Piece {
                 if k > 2 {
                     return Err(format!("face corner '{}' has more than v/vt/vn", String::from_utf8_lossy(t)).into());
                 }
-                let x = parse_int(part).ok_or_else(|| {
+                let x = short_int(part).ok_or_else(|| {
                     format!("face corner '{}' is not v, v/vt, v//vn or v/vt/vn", String::from_utf8_lossy(t))
                 })?;
                 let what = ["vertex", "texture coordinate", "normal"][k];

@@ -99,27 +99,11 @@ fn lines(piece: &[u8]) -> impl Iterator<Item = &[u8]> {
     })
 }
 
-/// An integer as `str::parse::<i64>` reads it (sign, then digits), without its UTF-8 check.
+/// An integer as `str::parse::<i64>` reads it: the shared short parser, and the standard one for
+/// what that leaves (a number too long for it, or not a number).
 #[inline]
 pub(super) fn int(t: &[u8]) -> Option<i64> {
-    let (neg, digits) = match t.first()? {
-        b'-' => (true, &t[1..]),
-        b'+' => (false, &t[1..]),
-        _ => (false, t),
-    };
-    if digits.is_empty() || digits.len() > 18 {
-        // Empty, or long enough to overflow: the standard parser decides.
-        return std::str::from_utf8(t).ok()?.parse().ok();
-    }
-    let mut v = 0i64;
-    for &c in digits {
-        let d = c.wrapping_sub(b'0');
-        if d > 9 {
-            return None;
-        }
-        v = v * 10 + d as i64;
-    }
-    Some(if neg { -v } else { v })
+    super::short_int(t).or_else(|| std::str::from_utf8(t).ok()?.parse().ok())
 }
 
 /// Vertex columns as the sequential reader keeps them.
