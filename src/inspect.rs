@@ -32,7 +32,12 @@ pub struct PrimInfo {
     pub mode: u64,
     pub material: Option<usize>,
     pub vertices: usize,
+    /// Triangles drawn (strips and fans counted as the triangles they make); 0 for points and
+    /// lines.
     pub triangles: usize,
+    /// What the mode draws, counted: `elements` of `element` (`points`, `lines`, `triangles`).
+    pub elements: usize,
+    pub element: &'static str,
     pub attributes: Vec<AttrInfo>,
     pub morph_targets: usize,
     pub has_tangents: bool,
@@ -43,6 +48,56 @@ pub struct PrimInfo {
     /// Materials of the primitive (variants) whose textures read other UVs than the tangents follow.
     pub tangent_conflicts: Vec<String>,
     pub tangents_not_needed: Option<String>,
+    /// Why the primitive's data cannot be read, when it cannot: every command that reads it
+    /// refuses the file with this message.
+    pub error: Option<String>,
+}
+
+/// A primitive as its JSON declares it: counts and formats, without reading any data.
+struct Declared {
+    vertices: usize,
+    index_count: Option<usize>,
+    attributes: Vec<AttrInfo>,
+    morph_targets: usize,
+}
+
+fn declared(scene: &Scene, r: crate::scene::PrimRef) -> Declared {
+    let pj = scene.prim_json(r);
+    let accessor = |v: &Value| v.as_u64().and_then(|i| scene.array("accessors").get(i as usize));
+    let count = |a: &Value| a.get("count").and_then(Value::as_u64).unwrap_or(0) as usize;
+    let mut attributes = Vec::new();
+    let mut vertices = 0;
+    for (name, idx) in pj.get("attributes").and_then(Value::as_object).into_iter().flatten() {
+        let Some(a) = accessor(idx) else { continue };
+        if name == "POSITION" || attributes.is_empty() {
+            vertices = count(a);
+        }
+        attributes.push(AttrInfo {
+            name: name.clone(),
+            r#type: a.get("type").and_then(Value::as_str).unwrap_or("").to_string(),
+            component_type: a.get("componentType").and_then(Value::as_u64).unwrap_or(0) as u32,
+            normalized: a.get("normalized").and_then(Value::as_bool).unwrap_or(false),
+        });
+    }
+    Declared {
+        vertices,
+        index_count: pj.get("indices").and_then(accessor).map(count),
+        attributes,
+        morph_targets: pj.get("targets").and_then(Value::as_array).map_or(0, Vec::len),
+    }
+}
+
+/// How many of what a primitive of `mode` with `n` indices (or vertices) draws.
+fn elements(mode: Mode, n: usize) -> (usize, &'static str) {
+    match mode.0 {
+        0 => (n, "points"),
+        1 => (n / 2, "lines"),
+        2 if n >= 2 => (n, "lines"),
+        2 => (0, "lines"),
+        3 => (n.saturating_sub(1), "lines"),
+        4 => (n / 3, "triangles"),
+        _ => (n.saturating_sub(2), "triangles"),
+    }
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -92,33 +147,34 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
     let mut primitives = Vec::new();
     for view in views(&scene, &mats) {
         let r = view.at;
-        let p = scene.declared_primitive(r)?;
+        let d = declared(&scene, r);
         let mode = view.mode;
         let need = needs_tangents(&view, false).map(|()| view.tangent_uvs());
         let by = need.as_ref().ok().and(view.tangent_need.as_ref());
+        // Listing reads the JSON; whether the data can be read is the reading rule's answer,
+        // the same every other command gets.
+        let error = scene.declared_primitive(r).err().map(|e| match e {
+            crate::Error::Input { msg, .. } => msg,
+            other => other.to_string(),
+        });
+        let (elements, element) = elements(mode, d.index_count.unwrap_or(d.vertices));
         primitives.push(PrimInfo {
             mesh: r.mesh,
             primitive: r.primitive,
             mode: mode.0,
             material: scene.material_index(r),
-            vertices: p.vertex_count(),
-            triangles: if mode == Mode::TRIANGLES { p.indices.len() / 3 } else { p.indices.len().saturating_sub(2) },
-            attributes: p
-                .attributes
-                .iter()
-                .map(|(n, s)| AttrInfo {
-                    name: n.clone(),
-                    r#type: s.format.ty.clone(),
-                    component_type: s.format.component_type,
-                    normalized: s.format.normalized,
-                })
-                .collect(),
-            morph_targets: p.targets.len(),
-            has_tangents: p.attr("TANGENT").is_some(),
+            vertices: d.vertices,
+            triangles: if mode.has_triangles() { elements } else { 0 },
+            elements,
+            element,
+            attributes: d.attributes,
+            morph_targets: d.morph_targets,
+            has_tangents: view.has("TANGENT"),
             tangents_needed_from: need.as_ref().ok().map(|u| u.attribute()),
             tangents_needed_by: by.map(|n| n.describe()),
             tangent_conflicts: by.map(|n| n.conflicts.clone()).unwrap_or_default(),
             tangents_not_needed: need.err(),
+            error,
         });
     }
     let materials = mats

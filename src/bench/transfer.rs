@@ -166,8 +166,8 @@ impl Mesh {
             let mut a =
                 serde_json::json!({ "bufferView": views.len() - 1, "componentType": ct, "count": count, "type": ty });
             if let Some((lo, hi)) = minmax {
-                a["min"] = serde_json::json!(lo);
-                a["max"] = serde_json::json!(hi);
+                crate::scene::set_key(&mut a, "min", serde_json::json!(lo));
+                crate::scene::set_key(&mut a, "max", serde_json::json!(hi));
             }
             accessors.push(a);
             accessors.len() - 1
@@ -184,8 +184,8 @@ impl Mesh {
         let nrm = push(bytemuck::cast_slice(&self.normals), self.normals.len(), "VEC3", 5126, 34962, None);
         let mut attrs = serde_json::json!({ "POSITION": pos, "NORMAL": nrm });
         if !self.uvs.is_empty() {
-            attrs["TEXCOORD_0"] =
-                serde_json::json!(push(bytemuck::cast_slice(&self.uvs), self.uvs.len(), "VEC2", 5126, 34962, None));
+            let uv = push(bytemuck::cast_slice(&self.uvs), self.uvs.len(), "VEC2", 5126, 34962, None);
+            crate::scene::set_key(&mut attrs, "TEXCOORD_0", serde_json::json!(uv));
         }
         let idx = push(bytemuck::cast_slice(&self.indices), self.indices.len(), "SCALAR", 5125, 34963, None);
         let mut prim = serde_json::json!({ "attributes": attrs, "indices": idx });
@@ -199,10 +199,14 @@ impl Mesh {
         while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
-        json["meshes"] = serde_json::json!([{ "primitives": [prim] }]);
-        json["bufferViews"] = serde_json::json!(views);
-        json["accessors"] = serde_json::json!(accessors);
-        json["buffers"] = serde_json::json!([{ "byteLength": bin.len() }]);
+        for (key, v) in [
+            ("meshes", serde_json::json!([{ "primitives": [prim] }])),
+            ("bufferViews", serde_json::json!(views)),
+            ("accessors", serde_json::json!(accessors)),
+            ("buffers", serde_json::json!([{ "byteLength": bin.len() }])),
+        ] {
+            crate::scene::set_key(&mut json, key, v);
+        }
         let mut j = serde_json::to_vec(&json).expect("serialises");
         while !j.len().is_multiple_of(4) {
             j.push(b' ');

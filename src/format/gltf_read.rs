@@ -91,10 +91,12 @@ fn build(
     source_format: SourceFormat,
     opts: &ReadOptions,
 ) -> Result<Scene> {
+    crate::scene::shape::check(&json).map_err(|e| Error::input(path, e.0))?;
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mut buffers = Vec::new();
     let mut deps = Vec::new();
     let mut bin = bin;
+    let mut absent = std::collections::BTreeSet::new();
     let list = json.get("buffers").and_then(|b| b.as_array()).cloned().unwrap_or_default();
     for (i, b) in list.iter().enumerate() {
         let declared =
@@ -114,9 +116,15 @@ fn build(
             None if meshopt::is_fallback(b) => {
                 return Err(Error::input(path, format!("buffer {i}: {declared} bytes is absurd for a fallback buffer")))
             }
-            None if i == 0 => return Err(Error::input(path, "buffer 0 has no uri and there is no GLB binary chunk")),
-            None => return Err(Error::input(path, format!("buffer {i} has no uri"))),
+            None => {
+                absent.insert(i);
+                Vec::new()
+            }
         };
+        if absent.contains(&i) {
+            buffers.push(data);
+            continue;
+        }
         if data.len() < declared {
             return Err(Error::input(
                 path,
@@ -141,6 +149,7 @@ fn build(
         height_maps: Vec::new(),
         ledger: Default::default(),
         material_cache: Default::default(),
+        absent_buffers: absent,
         own_images: false,
     };
     check_views(&scene)?;
@@ -153,6 +162,9 @@ fn check_views(s: &Scene) -> Result<()> {
         let b = v.get("buffer").and_then(as_index).ok_or_else(|| s.err(format!("bufferView {i} has no buffer")))?;
         let buf =
             s.buffers.get(b).ok_or_else(|| s.err(format!("bufferView {i} names buffer {b}, which does not exist")))?;
+        if s.absent_buffers.contains(&b) {
+            continue;
+        }
         let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0);
         let len = v
             .get("byteLength")

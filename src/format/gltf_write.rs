@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::output::Outputs;
 use crate::scene::compact::{pack_views, set_offset};
 use crate::scene::refs::{accessor_refs, drop_unreferenced, unknown_data_refs, view_refs, Dangling};
-use crate::scene::Scene;
+use crate::scene::{set_key, Scene};
 use base64::Engine as _;
 use serde_json::{json, Value};
 use std::borrow::Cow;
@@ -88,9 +88,11 @@ pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(O
         // could give it, so it stays stored the way the input stored it.
         let as_stored = core.contains(&i) && !scene.own_images && !core_mime(scene, i);
         let place = if as_stored {
+            // A GLB holds every embedded image in its binary chunk (data URIs are not allowed
+            // there).
             if plain_file {
                 Place::CopyBeside
-            } else if u.is_some() {
+            } else if u.is_some() && !glb {
                 Place::Keep
             } else {
                 Place::Buffer
@@ -152,13 +154,21 @@ pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(O
         new_images.push(img);
     }
     if !images.is_empty() {
-        json["images"] = Value::Array(new_images);
+        set_key(&mut json, "images", Value::Array(new_images));
     }
 
     // Buffer views: keep what kept accessors, images and compressed primitives use; repack.
     let dropped =
         drop_unreferenced(&mut json, "bufferViews", keep_all, view_refs).map_err(|d| dangling("bufferView", d))?;
     stats.buffer_views_dropped = dropped.gone.len() + scene.ledger.views_dropped;
+    for (i, v) in json.get("bufferViews").and_then(Value::as_array).into_iter().flatten().enumerate() {
+        let b = v.get("buffer").and_then(Value::as_u64).unwrap_or(0) as usize;
+        if scene.absent_buffers.contains(&b) {
+            return Err(scene.err(format!(
+                "bufferView {i} is kept in the output but reads buffer {b}, which has no data (no uri, and not a GLB's binary chunk)"
+            )));
+        }
+    }
     for p in pack_views(&mut json, &scene.buffers).ok_or_else(|| scene.err("bufferView runs past its buffer"))? {
         bin.pad4();
         debug_assert_eq!(bin.len, p.at);
@@ -172,25 +182,34 @@ pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(O
         bin.push(Cow::Owned(bytes));
         let views = crate::scene::array_mut(&mut json, "bufferViews");
         views.push(v);
-        json["images"][img]["bufferView"] = json!(views_len(&json) - 1);
+        let view = views.len() - 1;
+        if let Some(image) = json.pointer_mut(&format!("/images/{img}")) {
+            set_key(image, "bufferView", json!(view));
+        }
     }
     stats.buffer_bytes_out = bin.len;
 
     // One buffer, or none.
     let root = json.as_object_mut().ok_or_else(|| scene.err("glTF JSON is not an object"))?;
-    if bin.len == 0 && !root.contains_key("bufferViews") {
+    // glTF wants a buffer's byteLength to be 1 or more: with no bytes left, no buffer.
+    let no_views = root.get("bufferViews").and_then(Value::as_array).is_none_or(Vec::is_empty);
+    if bin.len == 0 && no_views {
         root.remove("buffers");
     } else {
         let mut b = json!({ "byteLength": bin.len });
         if !glb {
             if opts.embed {
-                b["uri"] = json!(format!(
-                    "data:application/octet-stream;base64,{}",
-                    base64::engine::general_purpose::STANDARD.encode(bin.parts.concat())
-                ));
+                set_key(
+                    &mut b,
+                    "uri",
+                    json!(format!(
+                        "data:application/octet-stream;base64,{}",
+                        base64::engine::general_purpose::STANDARD.encode(bin.parts.concat())
+                    )),
+                );
             } else {
                 let name = format!("{}.bin", out.file_stem().and_then(|s| s.to_str()).unwrap_or("scene"));
-                b["uri"] = json!(name);
+                set_key(&mut b, "uri", json!(name));
                 files.add_parts(out_dir.join(&name), std::mem::take(&mut bin).parts);
             }
         }
@@ -232,16 +251,13 @@ fn add_position_bounds(scene: &Scene, json: &mut Value) -> Result<()> {
         if (acc.get("min").is_some() && acc.get("max").is_some()) || acc.get("bufferView").is_none() {
             continue;
         }
-        if let Some((lo, hi)) = scene.accessor(i)?.bounds() {
-            json["accessors"][i]["min"] = lo;
-            json["accessors"][i]["max"] = hi;
+        if let (Some((lo, hi)), Some(acc)) = (scene.accessor(i)?.bounds(), json.pointer_mut(&format!("/accessors/{i}")))
+        {
+            set_key(acc, "min", lo);
+            set_key(acc, "max", hi);
         }
     }
     Ok(())
-}
-
-fn views_len(json: &Value) -> usize {
-    json.get("bufferViews").and_then(|a| a.as_array()).map(|a| a.len()).unwrap_or(0)
 }
 
 /// The output buffer as the pieces it is made of, most of them borrowed from the scene: the
@@ -300,7 +316,7 @@ fn copy_beside(img: &mut Value, u: &str, scene: &Scene, out_dir: &Path, files: &
     // A URI that climbs out of the folder (allowed by the user) lands beside the output by name.
     let rel = if u.contains("..") || u.starts_with('/') {
         let name = src.file_name().and_then(|n| n.to_str()).unwrap_or("image").to_string();
-        img["uri"] = json!(name.clone());
+        set_key(img, "uri", json!(name.clone()));
         name
     } else {
         u.to_string()

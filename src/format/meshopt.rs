@@ -25,7 +25,7 @@ pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut [Vec<u8>]) -> Res
     let mut any = false;
     let n_views = json.get("bufferViews").and_then(|v| v.as_array()).map_or(0, |v| v.len());
     for i in 0..n_views {
-        let view = &json["bufferViews"][i];
+        let Some(view) = json.pointer(&format!("/bufferViews/{i}")) else { continue };
         let Some(ext) = view.pointer("/extensions/EXT_meshopt_compression").cloned() else {
             continue;
         };
@@ -41,10 +41,12 @@ pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut [Vec<u8>]) -> Res
             .and_then(|b| b.get_mut(job.dst_offset..job.dst_offset.checked_add(job.dst_len)?))
             .ok_or_else(|| bad(format!("bufferView {i} runs past the end of buffer {}", job.dst_buffer)))?;
         job.decode(&src, dst).map_err(|m| bad(format!("bufferView {i}: {m}")))?;
-        if let Some(exts) = json["bufferViews"][i].get_mut("extensions").and_then(|e| e.as_object_mut()) {
-            exts.remove(EXT);
-            if exts.is_empty() {
-                json["bufferViews"][i].as_object_mut().map(|o| o.remove("extensions"));
+        if let Some(view) = json.pointer_mut(&format!("/bufferViews/{i}")).and_then(Value::as_object_mut) {
+            if let Some(exts) = view.get_mut("extensions").and_then(Value::as_object_mut) {
+                exts.remove(EXT);
+                if exts.is_empty() {
+                    view.remove("extensions");
+                }
             }
         }
     }

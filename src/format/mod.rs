@@ -96,11 +96,9 @@ impl Scene {
         let b = view.get("buffer").and_then(as_index).unwrap_or(0);
         let off = view.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
         let len = view.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
-        self.buffers
-            .get(b)
-            .and_then(|buf| buf.get(off..off.saturating_add(len)))
-            .map(|s| s.to_vec())
-            .ok_or_else(|| self.err(format!("image {i}: bufferView {v} runs past its buffer")))
+        self.buffer_range(b, off, len)
+            .map(<[u8]>::to_vec)
+            .map_err(|why| self.err(format!("image {i}: bufferView {v} {why}")))
     }
 
     /// Reads a primitive's streams, indices and morph targets.

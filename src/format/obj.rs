@@ -9,7 +9,9 @@ use super::obj_parse::{self, ObjData, Statement, MISSING};
 use crate::error::{Error, Result};
 use crate::scene::normals::{flat_normals, smooth_normals, unit_or_up};
 use crate::scene::weld::weld;
-use crate::scene::{array_mut, HeightMapRef, NormalMode, PrimRef, Primitive, ReadOptions, Scene, SourceFormat, Stream};
+use crate::scene::{
+    array_mut, set_key, HeightMapRef, NormalMode, PrimRef, Primitive, ReadOptions, Scene, SourceFormat, Stream,
+};
 use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -64,8 +66,9 @@ fn build_scene(path: &Path, data: ObjData, opts: &ReadOptions) -> Result<Scene> 
     let mut remap = Remaps::new(&data);
     for run in runs(&data, &material_ids) {
         let name = &run.name;
-        let mesh_idx = match scene.json.get("meshes").and_then(|m| m.as_array()).and_then(|m| m.last()) {
-            Some(last) if last["name"] == json!(name) => scene.json["meshes"].as_array().unwrap().len() - 1,
+        let meshes = scene.array("meshes");
+        let mesh_idx = match meshes.last() {
+            Some(last) if last.get("name") == Some(&json!(name)) => meshes.len() - 1,
             _ => {
                 let meshes = array_mut(&mut scene.json, "meshes");
                 meshes.push(json!({ "name": name, "primitives": [] }));
@@ -78,9 +81,10 @@ fn build_scene(path: &Path, data: ObjData, opts: &ReadOptions) -> Result<Scene> 
         uvs_to_gltf(&mut prim);
         let mut pj = json!({ "attributes": {} });
         if let Some(m) = run.material.filter(|&m| m < materials.len()) {
-            pj["material"] = json!(m);
+            set_key(&mut pj, "material", json!(m));
         }
-        let prims = scene.json["meshes"][mesh_idx]["primitives"].as_array_mut().expect("primitives array");
+        let mesh = array_mut(&mut scene.json, "meshes").get_mut(mesh_idx);
+        let prims = array_mut(mesh.ok_or_else(|| Error::input(path, "OBJ mesh vanished"))?, "primitives");
         prims.push(pj);
         let r = PrimRef { mesh: mesh_idx, primitive: prims.len() - 1 };
         scene.put_primitive(r, prim);
@@ -106,15 +110,16 @@ fn empty_scene(path: &Path, opts: &ReadOptions, format: SourceFormat, deps: Vec<
         height_maps: Vec::new(),
         ledger: Default::default(),
         material_cache: Default::default(),
+        absent_buffers: Default::default(),
         own_images: true,
     }
 }
 
 fn set_nodes(scene: &mut Scene, nodes: Vec<Value>) {
     let roots: Vec<usize> = (0..nodes.len()).collect();
-    scene.json["nodes"] = Value::Array(nodes);
-    scene.json["scenes"] = json!([{ "nodes": roots }]);
-    scene.json["scene"] = json!(0);
+    set_key(&mut scene.json, "nodes", Value::Array(nodes));
+    set_key(&mut scene.json, "scenes", json!([{ "nodes": roots }]));
+    set_key(&mut scene.json, "scene", json!(0));
 }
 
 /// A PLY mesh as a scene: one node and mesh named after the file, one primitive built exactly
@@ -137,7 +142,7 @@ pub fn ply_scene(path: &Path, ply: super::ply::PlyMesh, opts: &ReadOptions) -> R
     let mut scene = empty_scene(path, opts, SourceFormat::Ply, Vec::new());
     let mut prim = build_primitive(path, &model, opts.obj_normals, &mut scene.notes, &name)?;
     uvs_to_gltf(&mut prim);
-    scene.json["meshes"] = json!([{ "name": name, "primitives": [{ "attributes": {} }] }]);
+    set_key(&mut scene.json, "meshes", json!([{ "name": name, "primitives": [{ "attributes": {} }] }]));
     scene.put_primitive(PrimRef { mesh: 0, primitive: 0 }, prim);
     set_nodes(&mut scene, vec![json!({ "name": name, "mesh": 0 })]);
     Ok(scene)
@@ -371,7 +376,7 @@ fn parse_tex(s: &str) -> TexStatement {
 fn add_texture(scene: &mut Scene, file: &str) -> usize {
     let uri: String = file.replace('\\', "/").split('/').map(encode_segment).collect::<Vec<_>>().join("/");
     let images = array_mut(&mut scene.json, "images");
-    let img = match images.iter().position(|i| i["uri"] == json!(uri)) {
+    let img = match images.iter().position(|i| i.get("uri") == Some(&json!(uri))) {
         Some(i) => i,
         None => {
             images.push(json!({ "uri": uri }));
@@ -379,7 +384,7 @@ fn add_texture(scene: &mut Scene, file: &str) -> usize {
         }
     };
     let textures = array_mut(&mut scene.json, "textures");
-    match textures.iter().position(|t| t["source"] == json!(img)) {
+    match textures.iter().position(|t| t.get("source") == Some(&json!(img))) {
         Some(t) => t,
         None => {
             textures.push(json!({ "source": img }));
@@ -410,11 +415,13 @@ fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<(
         }
     });
     if alpha < 1.0 {
-        mat["alphaMode"] = json!("BLEND");
+        set_key(&mut mat, "alphaMode", json!("BLEND"));
     }
     if let Some(t) = &m.diffuse_texture {
         let t = add_texture(scene, &parse_tex(t).file);
-        mat["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": t });
+        if let Some(pbr) = mat.get_mut("pbrMetallicRoughness") {
+            set_key(pbr, "baseColorTexture", json!({ "index": t }));
+        }
     }
     let norm = m.unknown_param.get("norm").map(|s| (parse_tex(s), true));
     let bump = m.normal_texture.as_ref().map(|s| (parse_tex(s), false));
@@ -422,10 +429,11 @@ fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) -> Result<(
         let is_normal = always_normal || looks_like_normal_map(scene, &tex.file);
         if is_normal {
             let t = add_texture(scene, &tex.file);
-            mat["normalTexture"] = json!({ "index": t });
+            let mut info = json!({ "index": t });
             if tex.bm != 1.0 {
-                mat["normalTexture"]["scale"] = json!(tex.bm);
+                set_key(&mut info, "scale", json!(tex.bm));
             }
+            set_key(&mut mat, "normalTexture", info);
         } else {
             scene.height_maps.push(HeightMapRef {
                 material: index,

@@ -148,7 +148,7 @@ pub fn from_scene(scene: &Scene) -> Result<RawMesh> {
         if inst.mesh >= meshes {
             continue;
         }
-        let mesh_json = &scene.json["meshes"][inst.mesh];
+        let Some(mesh_json) = scene.array("meshes").get(inst.mesh) else { continue };
         let name = inst
             .node
             .and_then(|n| nodes.and_then(|a| a.get(n)).and_then(|n| n.get("name")).and_then(|s| s.as_str()))

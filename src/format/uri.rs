@@ -23,12 +23,15 @@ pub fn resolve(uri: &str, base_dir: &Path, source: &Path, allow_outside: bool) -
             Some(m) => (m, true),
             None => (meta, false),
         };
-        if !is_b64 {
-            return Err(Error::input(source, format!("data URI is not base64: {}", short(uri))));
-        }
-        let bytes = base64::engine::general_purpose::STANDARD
-            .decode(payload.trim())
-            .map_err(|e| Error::input(source, format!("data URI is not valid base64 ({e})")))?;
+        // RFC 2397 allows the payload percent-encoded as well as in base64.
+        let bytes = if is_b64 {
+            base64::engine::general_purpose::STANDARD
+                .decode(payload.trim())
+                .map_err(|e| Error::input(source, format!("data URI is not valid base64 ({e})")))?
+        } else {
+            percent_decode_bytes(payload)
+        };
+        let mime = mime.split(';').next().unwrap_or("");
         return Ok(Target::Data { mime: mime.to_string(), bytes });
     }
     if uri.contains("://") {
@@ -83,6 +86,10 @@ pub fn decoded_path(uri: &str) -> PathBuf {
 }
 
 fn percent_decode(s: &str) -> String {
+    String::from_utf8_lossy(&percent_decode_bytes(s)).into_owned()
+}
+
+fn percent_decode_bytes(s: &str) -> Vec<u8> {
     let b = s.as_bytes();
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
@@ -98,7 +105,7 @@ fn percent_decode(s: &str) -> String {
         out.push(b[i]);
         i += 1;
     }
-    String::from_utf8_lossy(&out).into_owned()
+    out
 }
 
 fn short(uri: &str) -> String {

@@ -289,7 +289,8 @@ fn view_bytes(s: &Scene, view: usize) -> Result<(&[u8], Option<usize>)> {
     let off = v.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
     let len = v.get("byteLength").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
     let stride = v.get("byteStride").and_then(|o| o.as_u64()).map(|x| x as usize);
-    Ok((&s.buffers[b][off..off + len], stride))
+    let bytes = s.buffer_range(b, off, len).map_err(|why| s.err(format!("bufferView {view} {why}")))?;
+    Ok((bytes, stride))
 }
 
 pub fn read_accessor(s: &Scene, idx: usize) -> Result<Stream> {

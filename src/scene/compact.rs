@@ -68,8 +68,9 @@ impl Scene {
         let held: usize = self.buffers.iter().map(|b| b.len()).sum();
         self.ledger.tail.get_or_insert(last);
         self.ledger.bytes_unheld += held - bin.len();
-        self.json["buffers"] = json!([{ "byteLength": bin.len() }]);
+        super::set_key(&mut self.json, "buffers", json!([{ "byteLength": bin.len() }]));
         self.buffers = vec![bin];
+        self.absent_buffers.clear();
     }
 
     /// Takes the data of primitives that are about to get new data out of the document, then
@@ -86,11 +87,13 @@ impl Scene {
                 self.ledger.detached.insert(r, template);
             }
             // Null keeps each key where it is, so the document reads the same once data is back.
-            primitive_accessor_refs(self.prim_json_mut(r), &mut |v| {
-                if as_index(v).is_some() {
-                    *v = Value::Null;
-                }
-            });
+            if let Some(pj) = self.prim_json_mut(r) {
+                primitive_accessor_refs(pj, &mut |v| {
+                    if as_index(v).is_some() {
+                        *v = Value::Null;
+                    }
+                });
+            }
         }
         self.compact();
     }
@@ -119,7 +122,7 @@ pub(crate) fn pack_views(json: &mut Value, buffers: &[Vec<u8>]) -> Option<Vec<Pi
         pieces.push(Piece { buffer, range: off..off + len, at });
     }
     for (v, p) in views.iter_mut().zip(&pieces) {
-        v["buffer"] = json!(0);
+        super::set_key(v, "buffer", json!(0));
         set_offset(v, p.at);
     }
     Some(pieces)
@@ -131,7 +134,7 @@ pub(crate) fn set_offset(v: &mut Value, at: usize) {
             o.remove("byteOffset");
         }
     } else {
-        v["byteOffset"] = json!(at);
+        super::set_key(v, "byteOffset", json!(at));
     }
 }
 
@@ -183,6 +186,7 @@ mod tests {
             "images": [{ "bufferView": 4, "mimeType": "image/png" }],
             "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "NORMAL": 3 }, "indices": 2, "material": 0, "extras": { "keep": true } }] }],
             "materials": [{ "normalTexture": { "index": 0 } }],
+            "textures": [{ "source": 0 }],
         });
         Scene::read_bytes(Path::new("t.gltf"), &serde_json::to_vec(&json).unwrap(), &ReadOptions::default()).unwrap()
     }

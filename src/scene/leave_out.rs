@@ -58,8 +58,8 @@ impl Scene {
             // The readings of the materials as they were, while their JSON changes.
             let infos = mats.list.clone();
             for (m, map) in plan.materials.iter().enumerate() {
-                if let Some(map) = map {
-                    texcoord::renumber_material(&mut self.json["materials"][m], &infos[m], map);
+                if let (Some(map), Some(mat)) = (map, self.json.pointer_mut(&format!("/materials/{m}"))) {
+                    texcoord::renumber_material(mat, &infos[m], map);
                 }
             }
             self.materials_changed();
@@ -74,7 +74,8 @@ impl Scene {
             } else {
                 format!("no texture reads it; {}", moved.join(", "))
             };
-            for (name, idx) in texcoord::renumber_primitive(self.prim_json_mut(r), map) {
+            let Some(pj) = self.prim_json_mut(r) else { continue };
+            for (name, idx) in texcoord::renumber_primitive(pj, map) {
                 let bytes = self.accessor_bytes(idx);
                 out.push(Removal { what: format!("mesh {} primitive {}: {name} ({why})", r.mesh, r.primitive), bytes });
             }
@@ -123,8 +124,12 @@ impl Scene {
         let mut out = Vec::new();
         for (r, drop) in plan {
             for (name, why) in drop {
-                let pj = self.prim_json_mut(r);
-                let idx = pj["attributes"].as_object_mut().and_then(|a| a.remove(&name)).and_then(|v| v.as_u64());
+                let Some(pj) = self.prim_json_mut(r) else { continue };
+                let idx = pj
+                    .get_mut("attributes")
+                    .and_then(serde_json::Value::as_object_mut)
+                    .and_then(|a| a.remove(&name))
+                    .and_then(|v| v.as_u64());
                 let mut target_idx = Vec::new();
                 if name == "TANGENT" {
                     for t in pj.get_mut("targets").and_then(|t| t.as_array_mut()).into_iter().flatten() {

@@ -433,9 +433,8 @@ impl Scene {
         let rs = self.primitives();
         let m = push_plain_material(&mut self.json, "bumpbake");
         for r in rs {
-            let pj = self.prim_json_mut(r);
-            if pj.get("material").is_none() {
-                pj["material"] = json!(m);
+            if let Some(pj) = self.prim_json_mut(r).and_then(Value::as_object_mut) {
+                pj.entry("material").or_insert(json!(m));
             }
         }
         self.materials_changed();
@@ -444,13 +443,13 @@ impl Scene {
     /// Gives material `m` texture `texture` as its normal texture (UV set 0), keeping the scale
     /// of the one it replaces.
     pub fn set_normal_texture(&mut self, m: usize, texture: usize) {
-        let mat = &mut self.json["materials"][m];
+        let Some(mat) = self.json.pointer_mut(&format!("/materials/{m}")) else { return };
         let scale = mat.pointer("/normalTexture/scale").cloned();
         let mut info = json!({ "index": texture });
         if let Some(Value::Number(n)) = scale {
-            info["scale"] = Value::Number(n);
+            super::set_key(&mut info, "scale", Value::Number(n));
         }
-        mat["normalTexture"] = info;
+        super::set_key(mat, "normalTexture", info);
         self.materials_changed();
     }
 
@@ -458,7 +457,7 @@ impl Scene {
     pub fn push_texture(&mut self, image: usize, sampler: Option<usize>) -> usize {
         let mut tex = json!({ "source": image });
         if let Some(s) = sampler {
-            tex["sampler"] = json!(s);
+            super::set_key(&mut tex, "sampler", json!(s));
         }
         let textures = super::array_mut(&mut self.json, "textures");
         textures.push(tex);
@@ -508,7 +507,8 @@ fn push_plain_material(doc: &mut Value, name: &str) -> usize {
 /// Gives `prim`, a primitive's JSON about to join the document `doc`, a new plain material named
 /// `name` (for documents built by hand, as `bench transfer`'s LOW).
 pub fn give_plain_material(doc: &mut Value, prim: &mut Value, name: &str) {
-    prim["material"] = json!(push_plain_material(doc, name));
+    let m = push_plain_material(doc, name);
+    super::set_key(prim, "material", json!(m));
 }
 
 #[cfg(test)]
@@ -517,7 +517,8 @@ mod tests {
     use crate::scene::ReadOptions;
     use std::path::Path;
 
-    fn scene(j: Value) -> Scene {
+    fn scene(mut j: Value) -> Scene {
+        crate::scene::shape::pad_references(&mut j);
         Scene::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&j).unwrap(), &ReadOptions::default()).unwrap()
     }
 

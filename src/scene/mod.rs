@@ -13,6 +13,7 @@ pub mod material;
 pub mod nodes;
 pub mod normals;
 pub mod refs;
+pub mod shape;
 pub mod texcoord;
 pub mod view;
 pub mod weld;
@@ -100,6 +101,9 @@ pub struct Scene {
     pub height_maps: Vec<HeightMapRef>,
     /// What compaction and appending did, for the writer's report.
     pub(crate) ledger: compact::Ledger,
+    /// Buffers whose bytes the file does not carry: no `uri`, and not a GLB's binary chunk. glTF
+    /// allows them; reading a view into one is an error, only for the command that reads it.
+    pub absent_buffers: std::collections::BTreeSet<usize>,
     /// [`Scene::materials`], once read.
     pub(crate) material_cache: std::sync::OnceLock<material::Materials>,
 }
@@ -183,16 +187,27 @@ impl Scene {
             template: None,
         };
         // Reuse the accessor path for the bytes, then keep only its buffer view.
-        let acc = self.push_accessor(&s, None, false);
-        let view = self.json["accessors"][acc]["bufferView"].clone();
-        array_mut(&mut self.json, "accessors").pop();
+        self.push_accessor(&s, None, false);
+        let view = array_mut(&mut self.json, "accessors").pop().and_then(|a| a.get("bufferView").cloned());
         let mut img = json!({ "bufferView": view, "mimeType": mime });
         if let Some(n) = name {
-            img["name"] = json!(n);
+            set_key(&mut img, "name", json!(n));
         }
         let images = array_mut(&mut self.json, "images");
         images.push(img);
         images.len() - 1
+    }
+
+    /// `len` bytes at `off` of buffer `b`, or why they cannot be read (said of the buffer view
+    /// that names them).
+    pub fn buffer_range(&self, b: usize, off: usize, len: usize) -> std::result::Result<&[u8], String> {
+        if self.absent_buffers.contains(&b) {
+            return Err(format!("reads buffer {b}, which has no data (no uri, and not a GLB's binary chunk)"));
+        }
+        self.buffers
+            .get(b)
+            .and_then(|buf| buf.get(off..off.checked_add(len)?))
+            .ok_or_else(|| format!("(bytes {off}..{}) runs past the end of buffer {b}", off.saturating_add(len)))
     }
 
     /// The image index a texture index shows, if any.
@@ -219,12 +234,14 @@ impl Scene {
         out
     }
 
+    /// The primitive's JSON (null for a primitive that does not exist).
     pub fn prim_json(&self, r: PrimRef) -> &Value {
-        &self.json["meshes"][r.mesh]["primitives"][r.primitive]
+        static NONE: Value = Value::Null;
+        self.json.pointer(&prim_pointer(r)).unwrap_or(&NONE)
     }
 
-    fn prim_json_mut(&mut self, r: PrimRef) -> &mut Value {
-        &mut self.json["meshes"][r.mesh]["primitives"][r.primitive]
+    fn prim_json_mut(&mut self, r: PrimRef) -> Option<&mut Value> {
+        self.json.pointer_mut(&prim_pointer(r))
     }
 
     /// The material JSON of a primitive, if it has one.
@@ -278,7 +295,8 @@ impl Scene {
         let count = attributes.first().map(|(_, s)| s.len()).unwrap_or(0);
         // Attributes the tangent math reads must be finite: a NaN there would end up in the output.
         for (name, s) in &attributes {
-            let used = name == "POSITION" || name == "NORMAL" || name.starts_with("TEXCOORD_");
+            // Unusable normals are repaired on reading ([`normals::repair_normals`]).
+            let used = name == "POSITION" || name.starts_with("TEXCOORD_");
             if used && s.format.component_type == FLOAT {
                 let mut bad = None;
                 s.for_each_element(|i, v| {
@@ -362,13 +380,12 @@ impl Scene {
                 .and_then(|i| self.array("accessors").get(i).cloned()),
         };
         let ii = self.push_stream(index_stream, Some(34963), false);
-        let pj = self.prim_json_mut(r);
-        pj["attributes"] = Value::Object(attrs);
-        pj["indices"] = json!(ii);
-        if has_targets {
-            pj["targets"] = Value::Array(target_maps);
-        }
-        if let Some(o) = pj.as_object_mut() {
+        if let Some(o) = self.prim_json_mut(r).and_then(Value::as_object_mut) {
+            o.insert("attributes".into(), Value::Object(attrs));
+            o.insert("indices".into(), json!(ii));
+            if has_targets {
+                o.insert("targets".into(), Value::Array(target_maps));
+            }
             if mode == 4 {
                 o.remove("mode");
             } else {
@@ -398,7 +415,7 @@ impl Scene {
         }
         if self.buffers.is_empty() || self.json.pointer("/buffers/0").is_none() {
             self.buffers.clear();
-            self.json["buffers"] = json!([]);
+            set_key(&mut self.json, "buffers", json!([]));
             self.ledger.restart();
         }
         self.ledger.appended(s.data.len(), self.buffers.last().map_or(0, |b| b.len()));
@@ -406,10 +423,10 @@ impl Scene {
         // keep the order they always had in the output.
         let mut view = json!({ "buffer": self.buffers.len(), "byteOffset": 0, "byteLength": s.data.len() });
         if let Some(st) = stride {
-            view["byteStride"] = json!(st);
+            set_key(&mut view, "byteStride", json!(st));
         }
         if let Some(t) = target {
-            view["target"] = json!(t);
+            set_key(&mut view, "target", json!(t));
         }
         let views = array_mut(&mut self.json, "bufferViews");
         views.push(view);
@@ -421,18 +438,18 @@ impl Scene {
             "type": s.format.ty,
         });
         if s.format.normalized {
-            acc["normalized"] = json!(true);
+            set_key(&mut acc, "normalized", json!(true));
         }
         if let Some(t) = &s.template {
             for key in ["name", "extras"] {
                 if let Some(v) = t.get(key) {
-                    acc[key] = v.clone();
+                    set_key(&mut acc, key, v.clone());
                 }
             }
         }
         if let Some((lo, hi)) = bounds {
-            acc["min"] = lo;
-            acc["max"] = hi;
+            set_key(&mut acc, "min", lo);
+            set_key(&mut acc, "max", hi);
         }
         array_mut(&mut self.json, "buffers").push(json!({ "byteLength": s.data.len() }));
         self.buffers.push(s.data);
@@ -466,9 +483,30 @@ pub(crate) fn as_index(v: &Value) -> Option<usize> {
     v.as_u64().map(|i| i as usize)
 }
 
-pub(crate) fn array_mut<'a>(root: &'a mut Value, key: &str) -> &'a mut Vec<Value> {
-    if !root.get(key).map(|v| v.is_array()).unwrap_or(false) {
-        root[key] = json!([]);
+/// The JSON pointer of a primitive.
+pub fn prim_pointer(r: PrimRef) -> String {
+    format!("/meshes/{}/primitives/{}", r.mesh, r.primitive)
+}
+
+/// Sets `key` on a JSON object. The reading rule ([`shape`]) makes every value the writers set a
+/// key on an object; anything else is left as it is rather than panicking.
+pub fn set_key(v: &mut Value, key: &str, value: Value) {
+    if let Some(o) = v.as_object_mut() {
+        o.insert(key.to_string(), value);
     }
-    root[key].as_array_mut().expect("just made an array")
+}
+
+/// The array `root[key]`, made (empty) when it is missing or not an array. A scene's root is
+/// always an object (the readers refuse anything else).
+pub(crate) fn array_mut<'a>(root: &'a mut Value, key: &str) -> &'a mut Vec<Value> {
+    if !root.get(key).is_some_and(Value::is_array) {
+        if !root.is_object() {
+            *root = json!({});
+        }
+        set_key(root, key, json!([]));
+    }
+    match root.get_mut(key) {
+        Some(Value::Array(a)) => a,
+        _ => unreachable!("an array was just put there"),
+    }
 }

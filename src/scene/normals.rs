@@ -127,3 +127,136 @@ mod tests {
         assert_eq!(a, b);
     }
 }
+
+/// What reading did to a primitive's NORMAL stream. glTF wants unit normals; a zero or non-finite
+/// one has no direction a renderer or MikkTSpace can use, so it is treated as missing.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct NormalRepair {
+    /// Normals that were zero or not finite (NaN, infinity).
+    pub unusable: usize,
+    /// Float normals of another length than 1 (beyond [`NORMAL_UNIT_TOLERANCE`]), brought to it.
+    pub renormalised: usize,
+    /// Every normal was unusable: NORMAL is gone, and the stages make flat normals as the glTF
+    /// spec asks of a client for a primitive without NORMAL.
+    pub dropped: bool,
+}
+
+/// How far from 1 a float normal's length may be: the Khronos glTF-Validator's tolerance for
+/// unit vectors.
+pub const NORMAL_UNIT_TOLERANCE: f32 = 0.00674;
+
+impl NormalRepair {
+    /// Whether anything was changed.
+    pub fn any(&self) -> bool {
+        self.unusable > 0 || self.renormalised > 0
+    }
+
+    /// The report's words for it, if anything was changed.
+    pub fn describe(&self) -> Option<String> {
+        let mut parts = Vec::new();
+        if self.dropped {
+            parts.push(format!(
+                "all {} normals were zero or not finite: treated as a missing NORMAL (flat normals made)",
+                self.unusable
+            ));
+        } else if self.unusable > 0 {
+            parts.push(format!(
+                "{} normals were zero or not finite: replaced by the angle-weighted normal of the faces around them",
+                self.unusable
+            ));
+        }
+        if self.renormalised > 0 {
+            parts.push(format!("{} normals were not unit length: normalised", self.renormalised));
+        }
+        (!parts.is_empty()).then(|| parts.join("; "))
+    }
+}
+
+/// Makes `p`'s NORMAL usable (see [`NormalRepair`]). `p` is a triangle list when it is a surface;
+/// zero or non-finite normals of other modes become +Z.
+pub fn repair_normals(p: &mut super::Primitive) -> NormalRepair {
+    let mut r = NormalRepair::default();
+    let Some(s) = p.attr("NORMAL") else { return r };
+    let float = s.format.component_type == super::accessor::FLOAT;
+    let mut values: Vec<[f32; 3]> = s.to_f32();
+    let mut bad = Vec::new();
+    for (i, n) in values.iter_mut().enumerate() {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if !len.is_finite() || len < 1e-12 || !n.iter().all(|c| c.is_finite()) {
+            bad.push(i);
+        } else if float && (len - 1.0).abs() > NORMAL_UNIT_TOLERANCE {
+            *n = [n[0] / len, n[1] / len, n[2] / len];
+            r.renormalised += 1;
+        }
+    }
+    r.unusable = bad.len();
+    if !r.any() {
+        return r;
+    }
+    if r.unusable == values.len() {
+        r.dropped = true;
+        r.renormalised = 0;
+        p.remove_attr("NORMAL");
+        return r;
+    }
+    if r.unusable > 0 {
+        let positions = p.positions();
+        let triangles: Vec<[u32; 3]> = if p.mode == 4 && positions.len() == values.len() {
+            p.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+        } else {
+            Vec::new()
+        };
+        let smooth = if triangles.is_empty() { Vec::new() } else { smooth_vertex_normals(&positions, &triangles) };
+        for i in bad {
+            values[i] = smooth.get(i).copied().unwrap_or([0.0, 0.0, 1.0]);
+        }
+    }
+    let template = p.attr("NORMAL").and_then(|s| s.template.clone());
+    let mut fixed = super::Stream::from_f32("VEC3", &values);
+    fixed.template = template;
+    p.set_attr("NORMAL", fixed);
+    r
+}
+
+#[cfg(test)]
+mod repair_tests {
+    use super::*;
+    use crate::scene::{Primitive, Stream};
+
+    fn quad(normals: &[[f32; 3]]) -> Primitive {
+        let pos = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        Primitive {
+            attributes: vec![
+                ("POSITION".into(), Stream::from_f32("VEC3", &pos)),
+                ("NORMAL".into(), Stream::from_f32("VEC3", normals)),
+            ],
+            targets: Vec::new(),
+            indices: vec![0, 1, 2, 0, 2, 3],
+            mode: 4,
+        }
+    }
+
+    #[test]
+    fn zero_and_nan_normals_take_the_faces_normal_and_long_ones_are_normalised() {
+        let mut p = quad(&[[0.0, 0.0, 0.0], [f32::NAN, 0.0, 1.0], [0.0, 0.0, 2.0], [0.0, 0.0, 1.0]]);
+        let r = repair_normals(&mut p);
+        assert_eq!(r, NormalRepair { unusable: 2, renormalised: 1, dropped: false });
+        assert_eq!(p.attr("NORMAL").unwrap().to_f32::<3>(), vec![[0.0, 0.0, 1.0]; 4]);
+    }
+
+    #[test]
+    fn all_zero_normals_are_a_missing_normal() {
+        let mut p = quad(&[[0.0; 3]; 4]);
+        let r = repair_normals(&mut p);
+        assert_eq!(r, NormalRepair { unusable: 4, renormalised: 0, dropped: true });
+        assert!(p.attr("NORMAL").is_none());
+    }
+
+    #[test]
+    fn unit_normals_are_left_as_stored() {
+        let mut p = quad(&[[0.0, 0.0, 1.0]; 4]);
+        let before = p.clone();
+        assert!(!repair_normals(&mut p).any());
+        assert_eq!(p, before);
+    }
+}

@@ -146,7 +146,7 @@ pub fn renumber_material(material: &mut Value, info: &MaterialInfo, map: &BTreeM
             0 => {
                 ti.as_object_mut().map(|o| o.remove("texCoord"));
             }
-            new => ti["texCoord"] = json!(new),
+            new => super::set_key(ti, "texCoord", json!(new)),
         }
         if let Some(c) = ti.pointer_mut("/extensions/KHR_texture_transform/texCoord") {
             *c = json!(to(t.tex_coord));
@@ -241,7 +241,8 @@ mod tests {
         assert_eq!(renumber_primitive(&mut p, &map), vec![("TEXCOORD_0".to_string(), Some(1))]);
         assert_eq!(p, json!({ "attributes": { "POSITION": 0, "TEXCOORD_0": 2 }, "targets": [{ "TEXCOORD_0": 5 }] }));
         let mut m = json!({ "normalTexture": { "index": 0, "texCoord": 1 }, "occlusionTexture": { "index": 1, "texCoord": 1, "extensions": { "KHR_texture_transform": { "texCoord": 1 } } } });
-        let doc = json!({ "asset": { "version": "2.0" }, "materials": [m] });
+        let mut doc = json!({ "asset": { "version": "2.0" }, "materials": [m] });
+        crate::scene::shape::pad_references(&mut doc);
         let scene = crate::scene::Scene::read_bytes(
             std::path::Path::new("m.gltf"),
             &serde_json::to_vec(&doc).unwrap(),

@@ -139,8 +139,9 @@ impl PrimView {
     /// cannot be read (Draco, broken accessors).
     pub fn read(&self, scene: &Scene) -> Result<Geometry> {
         let p = scene.primitive(self.at)?;
-        let primitive = if self.mode.has_triangles() { to_triangle_list(p) } else { p };
-        Ok(Geometry { primitive, tangent_uvs: self.tangent_uvs() })
+        let mut primitive = if self.mode.has_triangles() { to_triangle_list(p) } else { p };
+        let normal_repair = super::normals::repair_normals(&mut primitive);
+        Ok(Geometry { primitive, tangent_uvs: self.tangent_uvs(), normal_repair })
     }
 }
 
@@ -157,12 +158,14 @@ pub struct Geometry {
     pub primitive: Primitive,
     /// The UVs its tangents follow ([`PrimView::tangent_uvs`]).
     pub tangent_uvs: UvSource,
+    /// What reading did to unusable normals ([`super::normals::repair_normals`]).
+    pub normal_repair: super::normals::NormalRepair,
 }
 
 impl Geometry {
     /// A primitive whose tangents follow `tangent_uvs`.
     pub fn new(primitive: Primitive, tangent_uvs: UvSource) -> Geometry {
-        Geometry { primitive, tangent_uvs }
+        Geometry { primitive, tangent_uvs, normal_repair: Default::default() }
     }
 
     /// POSITION, borrowed when stored as floats; a point at the origin per vertex without one.
@@ -223,7 +226,8 @@ mod tests {
     use serde_json::json;
     use std::path::Path;
 
-    fn scene(j: Value) -> Scene {
+    fn scene(mut j: Value) -> Scene {
+        crate::scene::shape::pad_references(&mut j);
         Scene::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&j).unwrap(), &ReadOptions::default()).unwrap()
     }
 
@@ -231,6 +235,7 @@ mod tests {
     fn one_rule_picks_the_normal_texture_s_uvs_with_the_transform_override() {
         let s = scene(json!({
             "asset": { "version": "2.0" },
+            "accessors": [{ "componentType": 5126, "count": 3, "type": "VEC3" }],
             "textures": [{ "source": 0 }],
             "materials": [
                 { "normalTexture": { "index": 0, "texCoord": 0,

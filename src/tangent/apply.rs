@@ -85,7 +85,10 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimTangents>
             Err(why) => reports.push(report("skipped", Some(why), false)),
             Ok(()) => {
                 let g = view.read(scene)?;
+                let repaired = g.normal_repair.describe();
                 let why = match g.primitive.attr("TANGENT") {
+                    // Frames follow the normals: repaired normals need new tangents.
+                    Some(_) if repaired.is_some() => Some("existing tangents replaced (the normals changed)".into()),
                     Some(t) if !opts.overwrite => match invalid_tangents(t) {
                         0 => {
                             reports.push(report(
@@ -101,7 +104,7 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimTangents>
                     None => None,
                 };
                 let conflicts = view.tangent_need.iter().flat_map(|n| n.conflicts.iter().cloned());
-                let why = why.into_iter().chain(conflicts).collect::<Vec<_>>();
+                let why = repaired.into_iter().chain(why).chain(conflicts).collect::<Vec<_>>();
                 reports.push(report("generated", (!why.is_empty()).then(|| why.join("; ")), true));
                 work.push((r, g));
             }

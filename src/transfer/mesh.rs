@@ -130,11 +130,21 @@ pub fn is_triangles(scene: &Scene, r: PrimRef) -> bool {
 }
 
 fn node_name(scene: &Scene, n: usize) -> String {
-    scene.json["nodes"][n].get("name").and_then(|s| s.as_str()).map_or_else(|| format!("node {n}"), str::to_string)
+    scene
+        .array("nodes")
+        .get(n)
+        .and_then(|n| n.get("name"))
+        .and_then(|s| s.as_str())
+        .map_or_else(|| format!("node {n}"), str::to_string)
 }
 
 fn mesh_name(scene: &Scene, m: usize) -> String {
-    scene.json["meshes"][m].get("name").and_then(|s| s.as_str()).map_or_else(|| format!("mesh {m}"), str::to_string)
+    scene
+        .array("meshes")
+        .get(m)
+        .and_then(|m| m.get("name"))
+        .and_then(|s| s.as_str())
+        .map_or_else(|| format!("mesh {m}"), str::to_string)
 }
 
 /// Where the primitives `prims` are shown. A mesh shown by two nodes has one UV layout in two
@@ -173,7 +183,11 @@ pub fn place(scene: &Scene, prims: &[PrimRef], node: Option<&str>) -> Result<Vec
                 }
             }
         };
-        let part = inst.and_then(|i| i.node).and_then(|n| scene.json["nodes"][n].get("name")).and_then(|s| s.as_str());
+        let part = inst
+            .and_then(|i| i.node)
+            .and_then(|n| scene.array("nodes").get(n))
+            .and_then(|n| n.get("name"))
+            .and_then(|s| s.as_str());
         out.push(Placed {
             prim: r,
             world: inst.map(|i| i.world).filter(|w| *w != Mat4::IDENTITY),

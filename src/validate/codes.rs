@@ -80,6 +80,12 @@ codes! {
     TRIANGLE_SLIVER = Info, "very thin triangles give unstable tangents; consider remeshing them";
     /// A node shows a mesh through a transform with negative determinant (a mirrored instance).
     NODE_MIRRORED = Info, "renderers must flip the winding and the bitangent for mirrored instances; check that yours does";
+    /// NORMAL values that are zero, not finite, or not unit length. The Khronos validator does not
+    /// look at accessors without a bufferView, nor at sparse substitutions.
+    NORMAL_NOT_UNIT = Error, "store unit normals; `bumpbake tangents` replaces zero or non-finite ones by the faces' normal and normalises the rest";
+    /// A primitive whose data cannot be read: a buffer without data, an index past the vertex
+    /// count, attributes of unequal counts.
+    PRIMITIVE_UNREADABLE = Error, "repair the file's data (the message names what is wrong); every bumpbake command that reads this primitive refuses it";
     /// A primitive the checks cannot read (not triangles, compressed).
     PRIMITIVE_NOT_CHECKED = Info, "decompress or triangulate the mesh to have it checked";
     /// A compressed primitive (KHR_draco_mesh_compression) whose normal texture needs frames that

@@ -39,7 +39,35 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             subjects.push((s, None));
             continue;
         }
-        let g = view.read(scene)?;
+        let g = match view.read(scene) {
+            Ok(g) => g,
+            Err(e) => {
+                let why = match &e {
+                    crate::Error::Input { msg, .. } => msg.clone(),
+                    other => other.to_string(),
+                };
+                let f = Finding::new(Code::PRIMITIVE_UNREADABLE, 1, 1, "primitives", format!("cannot be read: {why}"));
+                s.check(Code::PRIMITIVE_UNREADABLE, Some(f));
+                subjects.push((s, None));
+                continue;
+            }
+        };
+        let nr = g.normal_repair;
+        let normal_finding = nr.any().then(|| {
+            let n = g.primitive.vertex_count();
+            let bad = nr.unusable + nr.renormalised;
+            Finding::new(
+                Code::NORMAL_NOT_UNIT,
+                bad,
+                n,
+                "vertices",
+                format!(
+                    "{} normals are zero or not finite and {} are not unit length; checked with them repaired",
+                    nr.unusable, nr.renormalised
+                ),
+            )
+        });
+        s.check(Code::NORMAL_NOT_UNIT, normal_finding);
         let p = &g.primitive;
         if p.attr("POSITION").map(|s| s.len()) != Some(p.vertex_count()) {
             let f = Finding::new(

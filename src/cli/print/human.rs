@@ -214,11 +214,12 @@ impl Human for Inspection {
         for p in &self.primitives {
             let attrs: Vec<String> = p.attributes.iter().map(|a| format!("{} {}", a.name, a.r#type)).collect();
             s += &format!(
-                "  mesh {} primitive {}: {} vertices, {} triangles, material {}\n    attributes: {}\n",
+                "  mesh {} primitive {}: {} vertices, {} {}, material {}\n    attributes: {}\n",
                 p.mesh,
                 p.primitive,
                 p.vertices,
-                p.triangles,
+                p.elements,
+                p.element,
                 p.material.map(|m| m.to_string()).unwrap_or("-".into()),
                 attrs.join(", ")
             );
@@ -232,6 +233,9 @@ impl Human for Inspection {
             s += &format!("    tangents: {t}\n");
             for c in &p.tangent_conflicts {
                 s += &format!("    note: {c}\n");
+            }
+            if let Some(e) = &p.error {
+                s += &format!("    UNREADABLE: {e}\n");
             }
         }
         for m in &self.materials {

@@ -2,6 +2,7 @@
 //! (`docs/json.md`). The schema and status come after the record's own fields, as they always have.
 
 use super::Record;
+use bumpbake::scene::set_key;
 use bumpbake::Error;
 use serde_json::{json, Map, Value};
 use std::path::Path;
@@ -9,9 +10,9 @@ use std::path::Path;
 /// The record of an input that went well.
 pub fn ok<R: Record>(r: &R) -> Value {
     let mut v = serde_json::to_value(r).expect("report serialises");
-    v["schema"] = json!(R::SCHEMA);
+    set_key(&mut v, "schema", json!(R::SCHEMA));
     if R::OK_STATUS {
-        v["status"] = json!("ok");
+        set_key(&mut v, "status", json!("ok"));
     }
     v
 }

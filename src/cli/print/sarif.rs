@@ -38,6 +38,8 @@ fn description(code: Code) -> &'static str {
         PRIMITIVE_COMPRESSED => {
             "A primitive whose material needs tangents is Draco-compressed: its frames cannot be checked."
         }
+        NORMAL_NOT_UNIT => "NORMAL values that are zero, not finite, or not unit length.",
+        PRIMITIVE_UNREADABLE => "A primitive whose data cannot be read (missing buffer data, index out of range).",
         PRIMITIVE_NOT_CHECKED => "A primitive the checks cannot read (not triangles, compressed, no POSITION).",
         NORMALMAP_UNREADABLE => "A material's normal-texture image could not be read or decoded.",
         NORMALMAP_NOT_DECODED => {
@@ -122,8 +124,9 @@ fn result(r: &Report, file_index: usize, file: &FileReport, sub: &Subject, f: &F
         },
     });
     if !paths.is_empty() {
-        location["logicalLocations"] =
+        let logical =
             paths.iter().map(|p| json!({ "name": sub.name, "fullyQualifiedName": p, "kind": "object" })).collect();
+        bumpbake::scene::set_key(&mut location, "logicalLocations", logical);
     }
     let mut text = format!("{}: {}", sub.name, f.message);
     if let Some(e) = f.examples.first() {
