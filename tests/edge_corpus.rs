@@ -51,6 +51,13 @@ fn documents(expect: &Value) -> Vec<String> {
     let listed: Vec<String> = expect["files"].as_object().unwrap().keys().cloned().collect();
     assert_eq!(on_disk, listed, "fixtures/edge/ and expect.json disagree: run make.py, then khronos.js");
     assert!(on_disk.len() >= 60, "the corpus shrank to {} documents", on_disk.len());
+    // A misspelt command or reason in may_refuse would silently allow nothing or anything.
+    for (name, entry) in expect["files"].as_object().unwrap() {
+        for (cmd, reason) in entry["may_refuse"].as_object().into_iter().flatten() {
+            assert!(CMDS.iter().any(|c| c.key == cmd), "{name}: may_refuse names no command: {cmd}");
+            assert!(expect["reasons"][reason.as_str().unwrap()].is_string(), "{name}: unknown reason {reason}");
+        }
+    }
     on_disk
 }
 
