@@ -92,10 +92,8 @@ fn run_cmd(cmd: &Cmd, input: &Path, dir: &Path) -> (Outcome, Vec<PathBuf>) {
 
 /// The failures of one command on one file, as report lines.
 fn check(name: &str, entry: &Value, cmd: &Cmd, input: &Path, o: &Outcome, written: &[PathBuf]) -> Vec<String> {
-    let mut bad = Vec::new();
-    let first_line = o.stderr.lines().find(|l| !l.trim().is_empty()).unwrap_or("").to_string();
-    let mut fail =
-        |why: String| bad.push(format!("{name} [{}] exit {:?}: {why} | stderr: {first_line}", cmd.name, o.code));
+    let mut whys = Vec::new();
+    let mut fail = |why: String| whys.push(why);
     let allowed: &[i32] = if cmd.key == "validate" { &[0, 1, 2] } else { &[0, 2] };
     if !o.code.is_some_and(|c| allowed.contains(&c)) {
         fail("exit code outside the contract".into());
@@ -126,7 +124,13 @@ fn check(name: &str, entry: &Value, cmd: &Cmd, input: &Path, o: &Outcome, writte
     if o.code == Some(0) && !cmd.out.is_empty() && !written.iter().any(|p| p.file_name().unwrap() == cmd.out) {
         fail(format!("exit 0 but {} was not written", cmd.out));
     }
-    bad
+    if whys.is_empty() {
+        return vec![];
+    }
+    // A panic's first line is only its location; the second says what happened.
+    let lines = if o.code == Some(101) { 2 } else { 1 };
+    let shown: Vec<&str> = o.stderr.lines().filter(|l| !l.trim().is_empty()).take(lines).collect();
+    vec![format!("{name} [{}] exit {:?}: {} | stderr: {}", cmd.name, o.code, whys.join("; "), shown.join(" / "))]
 }
 
 /// `inspect` counts primitives by mode: a points primitive is not "4 triangles".
