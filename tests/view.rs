@@ -35,3 +35,41 @@ fn no_stage_branches_on_the_source_uv_orientation() {
         }
     }
 }
+
+/// Untrusted JSON is read through typed access that can fail (`get`, `pointer`, `as_*`) and
+/// written through `scene::set_key`: `value["key"]` indexing, which panics when `value` is not an
+/// object, appears nowhere in the library or the binary outside tests. The shapes themselves are
+/// held once, on reading, by `scene::shape`.
+#[test]
+fn no_json_indexing_outside_tests() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut stack = vec![src];
+    let mut bad = Vec::new();
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+                continue;
+            }
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            if !name.ends_with(".rs") || name.ends_with("_tests.rs") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&p).unwrap();
+            let code = text.split("#[cfg(test)]").next().unwrap_or("");
+            for (i, line) in code.lines().enumerate() {
+                let b = line.as_bytes();
+                let indexed = (1..b.len()).any(|k| {
+                    b[k] == b'['
+                        && b.get(k + 1) == Some(&b'"')
+                        && (b[k - 1].is_ascii_alphanumeric() || matches!(b[k - 1], b'_' | b')' | b']'))
+                });
+                if indexed && !line.trim_start().starts_with("//") {
+                    bad.push(format!("{}:{}: {}", p.display(), i + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(bad.is_empty(), "JSON indexing (use get/pointer and scene::set_key):\n{}", bad.join("\n"));
+}

@@ -47,6 +47,8 @@ pub struct BakeJob {
 pub struct MaterialMap {
     pub material: usize,
     pub name: Option<String>,
+    /// The material is new: the file had none, and the map needed one.
+    pub created: bool,
     /// `height`, `normal` or `existing`.
     pub source: &'static str,
     pub file: Option<PathBuf>,
@@ -75,10 +77,13 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
     let mut t = Timings::default();
     let mut scene = t.time("read", || Scene::read(&job.mesh, &job.read))?;
     let mut deps = scene.dependencies();
-    scene.ensure_material();
+    let created = scene.ensure_material();
     let mut warnings = Vec::new();
-    let targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps, &mut warnings))?;
-    check_uv_sets(&scene, job)?;
+    let mut targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps, &mut warnings))?;
+    for target in targets.iter_mut() {
+        target.created = created == Some(target.material);
+    }
+    check_uv_sets(&scene, job, &mut warnings)?;
     let prims = t.time("tangents", || {
         apply(
             &mut scene,
@@ -122,32 +127,45 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
     })
 }
 
-/// A texture needs UV coordinates to be placed: a primitive without the set its material's
-/// textures read is refused, not written as a file renderers cannot draw.
-fn check_uv_sets(scene: &Scene, job: &BakeJob) -> Result<()> {
+/// A normal map needs UV coordinates to be placed: a primitive without the set its normal
+/// texture reads is refused, not written as a file renderers cannot draw. Other textures that
+/// read a set the primitive lacks are bake's concern only as far as saying so: they pass through
+/// as the input had them, with validate's fix.
+fn check_uv_sets(scene: &Scene, job: &BakeJob, warnings: &mut Vec<String>) -> Result<()> {
     let mats = scene.materials();
     for r in scene.primitives() {
-        if let Some((m, t)) = mats.missing_uv_sets(scene, r).into_iter().next() {
+        let attrs = scene.prim_json(r).get("attributes").and_then(|a| a.as_object());
+        let sets: Vec<&str> =
+            attrs.into_iter().flatten().map(|(k, _)| k.as_str()).filter(|k| k.starts_with("TEXCOORD_")).collect();
+        for (m, t) in mats.missing_uv_sets(scene, r) {
             let set = t.tex_coord;
+            let at = format!("mesh {} primitive {}", r.mesh, r.primitive);
+            if t.slot != crate::scene::Slot::Normal {
+                let msg = format!(
+                    "{} {} reads TEXCOORD_{set}, which {at} does not have: point the texture's texCoord at a set it has",
+                    m.label(),
+                    t.name()
+                );
+                if !warnings.contains(&msg) {
+                    warnings.push(msg);
+                }
+                continue;
+            }
             let what = if set == 0 {
                 "no UV coordinates (TEXCOORD_0)".to_string()
             } else {
                 format!("no UV set {set} (TEXCOORD_{set})")
             };
-            let fix = if job.mesh.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
-                "give the mesh UVs (vt lines in the OBJ) and bake again"
+            let fix = if !sets.is_empty() {
+                format!("point the normal texture's texCoord at a set the primitive has ({})", sets.join(", "))
+            } else if job.mesh.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+                "give the mesh UVs (vt lines in the OBJ) and bake again".to_string()
             } else {
-                "unwrap the mesh (give it UVs) and bake again"
+                "unwrap the mesh (give it UVs) and bake again".to_string()
             };
             return Err(Error::input(
                 &job.mesh,
-                format!(
-                    "mesh {} primitive {} has {what}, so {} cannot place its {} on it; {fix}",
-                    r.mesh,
-                    r.primitive,
-                    m.label(),
-                    t.name()
-                ),
+                format!("{at} has {what}, so {} cannot place its {} on it; {fix}", m.label(), t.name()),
             ));
         }
     }
@@ -204,7 +222,7 @@ fn attach_maps(
                 // The map is baked once tangents exist; a flat texel holds its place until then.
                 maps::attach(scene, m, &maps::flat_png(), &label);
                 let file = ts.highs.first().cloned();
-                out.push(MaterialMap { material: m, name, source: "high", file, convention: None });
+                out.push(MaterialMap { material: m, name, created: false, source: "high", file, convention: None });
             }
             MapSource::Height(p) | MapSource::Normal(p) => {
                 if made.is_none() {
@@ -224,7 +242,14 @@ fn attach_maps(
                 let (png, conv) = made.clone().expect("made above");
                 maps::attach(scene, m, &png, &label);
                 let source = if matches!(job.map, MapSource::Height(_)) { "height" } else { "normal" };
-                out.push(MaterialMap { material: m, name, source, file: Some(p.clone()), convention: conv });
+                out.push(MaterialMap {
+                    material: m,
+                    name,
+                    created: false,
+                    source,
+                    file: Some(p.clone()),
+                    convention: conv,
+                });
             }
             MapSource::Scene => {
                 if let Some(h) = scene.height_maps.iter().find(|h| h.material == m).cloned() {
@@ -235,12 +260,20 @@ fn attach_maps(
                     out.push(MaterialMap {
                         material: m,
                         name,
+                        created: false,
                         source: "height",
                         file: Some(h.path.clone()),
                         convention: None,
                     });
                 } else if has_normal_texture[m] {
-                    out.push(MaterialMap { material: m, name, source: "existing", file: None, convention: None });
+                    out.push(MaterialMap {
+                        material: m,
+                        name,
+                        created: false,
+                        source: "existing",
+                        file: None,
+                        convention: None,
+                    });
                 }
             }
         }

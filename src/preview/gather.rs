@@ -13,7 +13,7 @@ use crate::error::Result;
 use crate::scene::material::{MaterialInfo, TextureUse};
 use crate::scene::nodes::{instances, Instance};
 use crate::scene::view::views;
-use crate::scene::{flat_normals, Geometry, Materials, Mode, PrimRef, PrimView, Scene, Slot, UvSource, UvTransform};
+use crate::scene::{flat_normals, Geometry, Materials, PrimRef, PrimView, Scene, Slot, UvSource, UvTransform};
 use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -178,12 +178,13 @@ impl Cx<'_> {
     fn local(&mut self, view: &PrimView) -> Result<Option<Local>> {
         let s = self.scene;
         let r = view.at;
-        let mut g = view.read(s)?;
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
-        if view.mode != Mode::TRIANGLES {
-            self.notes.push(format!("{where_}: mode {} is not a triangle list; not drawn", view.mode));
+        // Strips and fans are drawn as the triangles they make, as `tangents` processes them.
+        if !view.mode.has_triangles() {
+            self.notes.push(format!("{where_}: mode {} draws no triangles; not drawn", view.mode));
             return Ok(None);
         }
+        let mut g = view.read(s)?;
         if g.primitive.attr("POSITION").is_none() {
             self.notes.push(format!("{where_}: no POSITION; not drawn"));
             return Ok(None);

@@ -424,20 +424,22 @@ impl Scene {
         })
     }
 
-    /// A scene without materials gets a plain one (untextured, not metallic), shown by every
-    /// primitive without a material, so that a map has somewhere to go.
-    pub fn ensure_material(&mut self) {
-        if !self.array("materials").is_empty() {
-            return;
-        }
+    /// A scene without materials gets a plain one (untextured, not metallic, unnamed: the file
+    /// never had it), shown by every primitive without a material, so that a map has somewhere
+    /// to go. Returns its index, when one was made: a scene without primitives gets none.
+    pub fn ensure_material(&mut self) -> Option<usize> {
         let rs = self.primitives();
-        let m = push_plain_material(&mut self.json, "bumpbake");
+        if !self.array("materials").is_empty() || rs.is_empty() {
+            return None;
+        }
+        let m = push_plain_material(&mut self.json, None);
         for r in rs {
             if let Some(pj) = self.prim_json_mut(r).and_then(Value::as_object_mut) {
                 pj.entry("material").or_insert(json!(m));
             }
         }
         self.materials_changed();
+        Some(m)
     }
 
     /// Gives material `m` texture `texture` as its normal texture (UV set 0), keeping the scale
@@ -498,16 +500,20 @@ impl Scene {
 /// Appends a plain material named `name` to the glTF document `doc` and returns its index:
 /// untextured and not metallic (glTF's default metallic factor of 1 looks black without an
 /// environment to reflect), for meshes that come without one.
-fn push_plain_material(doc: &mut Value, name: &str) -> usize {
+fn push_plain_material(doc: &mut Value, name: Option<&str>) -> usize {
+    let mut m = json!({ "pbrMetallicRoughness": { "metallicFactor": 0.0 } });
+    if let Some(n) = name {
+        super::set_key(&mut m, "name", json!(n));
+    }
     let materials = super::array_mut(doc, "materials");
-    materials.push(json!({ "name": name, "pbrMetallicRoughness": { "metallicFactor": 0.0 } }));
+    materials.push(m);
     materials.len() - 1
 }
 
 /// Gives `prim`, a primitive's JSON about to join the document `doc`, a new plain material named
 /// `name` (for documents built by hand, as `bench transfer`'s LOW).
 pub fn give_plain_material(doc: &mut Value, prim: &mut Value, name: &str) {
-    let m = push_plain_material(doc, name);
+    let m = push_plain_material(doc, Some(name));
     super::set_key(prim, "material", json!(m));
 }
 

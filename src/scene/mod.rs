@@ -292,7 +292,11 @@ impl Scene {
                 targets.push(streams);
             }
         }
-        let count = attributes.first().map(|(_, s)| s.len()).unwrap_or(0);
+        let (first, count) = attributes
+            .iter()
+            .find(|(n, _)| n == "POSITION")
+            .or(attributes.first())
+            .map_or(("POSITION", 0), |(n, s)| (n.as_str(), s.len()));
         // Attributes the tangent math reads must be finite: a NaN there would end up in the output.
         for (name, s) in &attributes {
             // Unusable normals are repaired on reading ([`normals::repair_normals`]).
@@ -309,11 +313,14 @@ impl Scene {
                 }
             }
         }
-        for (name, s) in attributes.iter().chain(targets.iter().flatten()) {
+        let named = attributes.iter().map(|(n, s)| (format!("attribute {n}"), s));
+        let in_targets = targets
+            .iter()
+            .enumerate()
+            .flat_map(|(t, ss)| ss.iter().map(move |(n, s)| (format!("morph target {t}'s {n}"), s)));
+        for (name, s) in named.chain(in_targets) {
             if s.len() != count {
-                return Err(
-                    self.err(format!("{where_}: attribute {name} has {} elements, POSITION has {count}", s.len()))
-                );
+                return Err(self.err(format!("{where_}: {name} has {} elements, {first} has {count}", s.len())));
             }
         }
         let indices = match pj.get("indices") {

@@ -85,6 +85,11 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimTangents>
             Err(why) => reports.push(report("skipped", Some(why), false)),
             Ok(()) => {
                 let g = view.read(scene)?;
+                if g.primitive.indices.is_empty() {
+                    // Nothing to make frames for; rewriting it would only write empty accessors.
+                    reports.push(report("skipped", Some("no triangles (too few indices)".into()), false));
+                    continue;
+                }
                 let repaired = g.normal_repair.describe();
                 let why = match g.primitive.attr("TANGENT") {
                     // Frames follow the normals: repaired normals need new tangents.

@@ -77,7 +77,12 @@ impl Human for BakeReport {
         let mut s = format!("{} -> {}\n", self.input.display(), self.output.display());
         for m in &self.maps {
             let from = m.file.as_ref().map(|f| format!(" from {}", f.display())).unwrap_or_default();
-            s += &format!("  material {} {}: {} map{from}", m.material, m.name.as_deref().unwrap_or(""), m.source);
+            let what = match (&m.name, m.created) {
+                (_, true) => "(new: the file had none)".to_string(),
+                (Some(n), false) => n.clone(),
+                (None, false) => String::new(),
+            };
+            s += &format!("  material {} {what}: {} map{from}", m.material, m.source);
             if let Some(c) = &m.convention {
                 s += &format!(
                     " (looks {} at {:.2}{})",
