@@ -1,6 +1,7 @@
 //! Bad input ends with exit 2, one line naming the file and the problem, no output, no panic.
 
 mod common;
+use bumpbake::scene::PrimRef;
 use common::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -315,17 +316,34 @@ fn more_obj_garbage() {
 }
 
 #[test]
-fn nan_normal_or_uv_is_refused() {
+fn nan_uv_is_refused_and_a_nan_normal_repaired() {
     let d = case("nan_attr");
-    for (acc, what) in [(1usize, "NORMAL"), (2, "TEXCOORD_0")] {
+    let with_infinity = |acc: usize, name: &str| {
         let mut g = Gltf::new();
         simple(&mut g);
         let off = g.json["bufferViews"][acc]["byteOffset"].as_u64().unwrap() as usize;
         g.bin[off + 4..off + 8].copy_from_slice(&f32::INFINITY.to_le_bytes());
-        let f = d.join(format!("{what}.glb"));
+        let f = d.join(format!("{name}.glb"));
         g.write_glb(&f);
-        fails_cleanly(&f, &format!("{what} 0 is not finite"));
+        f
+    };
+    fails_cleanly(&with_infinity(2, "TEXCOORD_0"), "TEXCOORD_0 0 is not finite");
+    // A normal without a direction is one the file did not give: made again from the faces
+    // (docs/validate.md, NORMAL_NOT_UNIT), and said.
+    let f = with_infinity(1, "NORMAL");
+    let out = d.join("out").join("normal.glb");
+    let o = run_ok(&["tangents", s(&f), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("1 normals were zero or not finite"), "{err}");
+    let scene = load(&out);
+    let r = PrimRef { mesh: 0, primitive: 0 };
+    for n in corner_attr::<3>(&scene, r, "NORMAL") {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        assert!((len - 1.0).abs() < 1e-5, "{n:?}");
     }
+    let v = run(&["validate", s(&f)]);
+    assert_eq!(v.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&v.stderr).contains("NORMAL_NOT_UNIT"));
 }
 
 /// A failure while writing (the folder is missing, a file or folder is in the way, the folder is

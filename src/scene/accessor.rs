@@ -323,7 +323,16 @@ pub fn read_accessor(s: &Scene, idx: usize) -> Result<Stream> {
             if col_pad {
                 return Err(s.err(format!("accessor {idx}: padded matrix layouts are not supported")));
             }
-            let need = if count == 0 { 0 } else { off + stride * (count - 1) + es };
+            let need = match count {
+                0 => Some(0),
+                _ => stride.checked_mul(count - 1).and_then(|x| x.checked_add(off)).and_then(|x| x.checked_add(es)),
+            };
+            let Some(need) = need.filter(|&n| n <= bytes.len()) else {
+                return Err(s.err(format!(
+                    "accessor {idx} (byteOffset {off}, {count} elements {stride} bytes apart) runs past bufferView {view}, which has {} bytes",
+                    bytes.len()
+                )));
+            };
             if need > bytes.len() {
                 return Err(s.err(format!(
                     "accessor {idx} needs {need} bytes of bufferView {view}, which has {}",
@@ -355,7 +364,8 @@ fn apply_sparse(s: &Scene, idx: usize, sp: &Value, es: usize, count: usize, data
     let voff = sp.pointer("/values/byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
     let (ib, _) = view_bytes(s, iv)?;
     let (vb, _) = view_bytes(s, vv)?;
-    if ioff + n * ics > ib.len() || voff + n * es > vb.len() {
+    let end = |off: usize, size: usize| n.checked_mul(size).and_then(|x| x.checked_add(off));
+    if end(ioff, ics).is_none_or(|e| e > ib.len()) || end(voff, es).is_none_or(|e| e > vb.len()) {
         return Err(bad("data runs past its bufferView"));
     }
     for k in 0..n {
