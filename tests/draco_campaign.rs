@@ -40,7 +40,7 @@ fn mutant(src: &[u8], i: usize, rng: &mut u64) -> Vec<u8> {
         *rng as usize
     };
     let mut b = src.to_vec();
-    if i % 2 == 0 {
+    if i.is_multiple_of(2) {
         let k = i / 2;
         let len = if k < 40 { k } else { next() % b.len() };
         b.truncate(len);
