@@ -4,6 +4,8 @@
 //! then go through the whole glTF reader inside each file the streams came from, so the glue that
 //! checks the decoded data against the accessors is held to the same rule.
 
+mod common;
+use common::{run_ok, s, validated_dir};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -215,4 +217,87 @@ fn a_broken_stream_is_one_line_naming_the_file_and_the_primitive() {
     assert!(e.starts_with("/nonexistent-bumpbake/broken.glb: mesh 0 primitive 0: "), "{e}");
     assert!(e.contains("KHR_draco_mesh_compression stream could not be decoded ("), "{e}");
     assert!(!e.contains('\n') && !e.contains("Some(") && !e.contains("{ "), "{e}");
+}
+
+/// `mirror_small.draco.glb` with its JSON changed by `f`, read.
+fn read_changed(f: impl FnOnce(&mut serde_json::Value)) -> Result<bumpbake::scene::Scene, String> {
+    let mut glb = Glb::read(&root().join("fixtures/real/mirror_small.draco.glb"));
+    f(&mut glb.json);
+    let stream = glb.stream();
+    let path = Path::new("/nonexistent-bumpbake/changed.glb");
+    bumpbake::scene::Scene::read_bytes(path, &glb.with(&stream), &Default::default()).map_err(|e| e.to_string())
+}
+
+fn positions(scene: &bumpbake::scene::Scene, primitive: usize) -> Vec<[f32; 3]> {
+    scene.primitive(bumpbake::scene::PrimRef { mesh: 0, primitive }).unwrap().positions()
+}
+
+#[test]
+fn decoded_counts_and_types_must_match_the_accessors() {
+    let e = read_changed(|j| {
+        let pos = j["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize;
+        j["accessors"][pos]["count"] = 300.into();
+    })
+    .err()
+    .unwrap();
+    assert!(e.contains("mesh 0 primitive 0: KHR_draco_mesh_compression: the stream decodes 310 points"), "{e}");
+    let e = read_changed(|j| {
+        let uv = j["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"].as_u64().unwrap() as usize;
+        j["accessors"][uv]["componentType"] = 5123.into();
+        j["accessors"][uv]["normalized"] = true.into();
+    })
+    .err()
+    .unwrap();
+    assert!(e.contains("TEXCOORD_0") && e.contains("holds floats"), "{e}");
+    let e = read_changed(|j| {
+        let i = j["meshes"][0]["primitives"][0]["indices"].as_u64().unwrap() as usize;
+        j["accessors"][i]["count"] = 3.into();
+    })
+    .err()
+    .unwrap();
+    assert!(e.contains("could not be decoded") || e.contains("triangles"), "{e}");
+}
+
+#[test]
+fn primitives_sharing_accessors_or_without_indices_read_as_the_original() {
+    let plain = read_changed(|_| {}).unwrap();
+    let want = positions(&plain, 0);
+    let triangles = plain.primitive(bumpbake::scene::PrimRef { mesh: 0, primitive: 0 }).unwrap().indices.len();
+    // A second primitive with the same stream and accessors: the accessors are shared, not doubled.
+    let twice = read_changed(|j| {
+        let p = j["meshes"][0]["primitives"][0].clone();
+        j["meshes"][0]["primitives"].as_array_mut().unwrap().push(p);
+    })
+    .unwrap();
+    assert_eq!(positions(&twice, 0), want);
+    assert_eq!(positions(&twice, 1), want);
+    assert_eq!(twice.json["accessors"].as_array().unwrap().len(), plain.json["accessors"].as_array().unwrap().len());
+    // No indices accessor: one is made from the decoded faces.
+    let unindexed = read_changed(|j| {
+        j["meshes"][0]["primitives"][0].as_object_mut().unwrap().remove("indices");
+    })
+    .unwrap();
+    let p = unindexed.primitive(bumpbake::scene::PrimRef { mesh: 0, primitive: 0 }).unwrap();
+    assert_eq!((p.positions(), p.indices.len()), (want, triangles));
+    assert!(!unindexed.json.to_string().contains("KHR_draco_mesh_compression"));
+}
+
+#[test]
+fn bake_from_reads_a_draco_low_and_high_and_writes_the_same_counts_as_the_plain_pair() {
+    let d = validated_dir("draco_bake_from");
+    let plain = root().join("fixtures/blender_scene/plain");
+    let mut verts = Vec::new();
+    for (low, high, out) in
+        [("torus_low_draco.glb", "torus_high_draco.glb", "draco.glb"), ("torus_low.glb", "torus_high.glb", "plain.glb")]
+    {
+        let out = d.join(out);
+        let (low, high) = (plain.join(low), plain.join(high));
+        run_ok(&["bake", s(&low), "--from", s(&high), "-o", s(&out), "--size", "64", "-q"]);
+        let scene = bumpbake::scene::Scene::read(&out, &Default::default()).unwrap();
+        assert!(!scene.json.to_string().contains("KHR_draco_mesh_compression"));
+        let p = scene.primitive(bumpbake::scene::PrimRef { mesh: 0, primitive: 0 }).unwrap();
+        assert!(p.attr("TANGENT").is_some(), "{}", out.display());
+        verts.push(p.indices.len());
+    }
+    assert_eq!(verts[0], verts[1], "the Draco LOW decodes to the plain LOW's triangles");
 }

@@ -8,7 +8,7 @@
 use crate::error::{Error, Result};
 use crate::scene::accessor::{component_count, component_size, FLOAT, UNSIGNED_INT, UNSIGNED_SHORT};
 use crate::scene::as_index;
-use draco_core::{DataType, DecodeLimits, DecoderBuffer, Mesh, MeshDecoder, PointAttribute, PointIndex};
+use draco_core::{DataType, DecodeLimits, DecoderBuffer, ErrorKind, Mesh, MeshDecoder, PointAttribute, PointIndex};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -65,7 +65,11 @@ pub fn decode_stream(stream: &[u8], limits: DecodeLimits) -> std::result::Result
     let mut mesh = Mesh::new();
     MeshDecoder::new()
         .decode(&mut DecoderBuffer::new(stream).with_limits(limits), &mut mesh)
-        .map_err(|e| e.to_string().replace(['\n', '\r'], " "))?;
+        .map_err(|e| match e.kind() {
+            ErrorKind::LimitExceeded => format!("it holds more than the accessors declare: {}", e.message()),
+            _ => e.to_string(),
+        })
+        .map_err(|e| e.replace(['\n', '\r'], " "))?;
     Ok(mesh)
 }
 
