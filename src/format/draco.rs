@@ -92,7 +92,7 @@ pub fn decode_and_read(stream: &[u8]) -> std::result::Result<(usize, usize), Str
 }
 
 /// The stream may not decode to more than its primitive's accessors declare: a stream that does is
-/// refused anyway, and the ceiling stops its decode before it allocates.
+/// refused anyway, and the ceilings let the decoder refuse it before allocating what it claims.
 fn limits(json: &Value, prim: &Value) -> DecodeLimits {
     let count = |i: Option<&Value>| {
         i.and_then(as_index).and_then(|i| json.pointer(&format!("/accessors/{i}/count"))).and_then(|c| c.as_u64())
@@ -126,8 +126,8 @@ fn stream_bytes<'a>(json: &Value, buffers: &'a [Vec<u8>], ext: &Value) -> std::r
 struct Out {
     buffer: usize,
     bytes: Vec<u8>,
-    /// Accessor already given data by a decoded primitive -> the bytes it was given.
-    written: BTreeMap<usize, Vec<u8>>,
+    /// Accessor already given data by a decoded primitive -> where in `bytes` that data lies.
+    written: BTreeMap<usize, std::ops::Range<usize>>,
 }
 
 impl Out {
@@ -229,7 +229,7 @@ impl Out {
     /// an accessor, which only odd files do).
     fn assign(&mut self, json: &mut Value, acc: usize, data: Vec<u8>, target: u32, stride: Option<usize>) -> usize {
         let acc = match self.written.get(&acc) {
-            Some(d) if *d == data => return acc,
+            Some(r) if self.bytes[r.clone()] == data[..] => return acc,
             Some(_) => {
                 let copy = json["accessors"][acc].clone();
                 let accs = crate::scene::array_mut(json, "accessors");
@@ -239,9 +239,10 @@ impl Out {
             None => acc,
         };
         self.bytes.resize(self.bytes.len().next_multiple_of(4), 0);
+        let at = self.bytes.len();
         let mut view = json!({
             "buffer": self.buffer,
-            "byteOffset": self.bytes.len(),
+            "byteOffset": at,
             "byteLength": data.len(),
             "target": target,
         });
@@ -255,7 +256,7 @@ impl Out {
         let a = &mut json["accessors"][acc];
         a["bufferView"] = json!(v);
         a.as_object_mut().map(|o| o.remove("byteOffset"));
-        self.written.insert(acc, data);
+        self.written.insert(acc, at..at + data.len());
         acc
     }
 }
