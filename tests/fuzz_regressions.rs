@@ -51,3 +51,10 @@ fn ktx2_read_regressions() {
         let _ = bumpbake::format::image::decode(&std::fs::read(&f).unwrap());
     }
 }
+
+#[test]
+fn draco_decode_regressions() {
+    for f in inputs("draco_decode") {
+        let _ = bumpbake::format::draco::decode_and_read(&std::fs::read(&f).unwrap());
+    }
+}

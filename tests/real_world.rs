@@ -146,28 +146,47 @@ fn a_rotated_or_flipped_frame_in_a_quantized_file_is_still_an_error() {
     assert_spoilt_frames_fail(&real("mirror_small.gltfpack.glb"), &scratch_dir("real_rotated"));
 }
 
+/// A Draco file, decoded on reading: `tangents --overwrite` writes it uncompressed with the
+/// MikkTSpace frames of the decoded geometry, `preview` draws it, `validate` checks its frames and
+/// reads its normal map. Returns the validate report.
+fn assert_draco_decoded(input: &Path, out_dir: &Path, scratch: &Path) -> serde_json::Value {
+    let stem = input.file_stem().unwrap().to_str().unwrap();
+    let out = out_dir.join(format!("{stem}.decoded.glb"));
+    let o = run_ok(&["tangents", s(input), "-o", s(&out), "--overwrite", "--json"]);
+    record_input(&out, input, &[]);
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["generated"], 1, "{stem}: {report}");
+    assert!(report["notes"].to_string().contains("KHR_draco_mesh_compression: decoded"), "{stem}: {report}");
+    assert!(assert_mikktspace(&out) > 500, "{stem}: most corners compared");
+    let json = load(&out).json;
+    assert!(!json.to_string().contains("KHR_draco_mesh_compression"), "{stem}: written uncompressed");
+    let png = scratch.join(format!("{stem}.png"));
+    run_ok(&["preview", s(input), "-o", s(&png)]);
+    assert!(image::open(&png).unwrap().width() > 0);
+    let o = run(&["validate", "--format", "json", s(input)]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let subjects = v["files"][0]["subjects"].as_array().unwrap();
+    let checked =
+        |kind: &str| subjects.iter().any(|x| x["kind"] == kind && !x["checks"].as_array().unwrap().is_empty());
+    assert!(checked("primitive") && checked("image"), "{stem}: frames and map checked: {v}");
+    assert!(!v.to_string().contains("PRIMITIVE_NOT_CHECKED\""), "{stem}: {v}");
+    v
+}
+
 #[test]
-fn draco_primitives_that_need_tangents_are_refused_with_the_way_out() {
+fn draco_files_are_decoded_for_every_command() {
     let input = real("mirror_small.draco.glb");
-    let d = scratch_dir("real_draco");
-    for args in [
-        vec!["tangents", s(&input), "-o", s(&d.join("t.glb"))],
-        vec!["tangents", s(&input), "-o", s(&d.join("t.glb")), "--overwrite"],
-        vec!["bake", s(&input), "-o", s(&d.join("b.glb"))],
-        vec!["preview", s(&input), "-o", s(&d.join("p.png"))],
-    ] {
-        let o = run(&args);
-        assert_plain_refusal(&o, &input, "KHR_draco_mesh_compression");
-        assert!(String::from_utf8_lossy(&o.stderr).contains("gltf-transform"), "names the way out");
-        assert!(std::fs::read_dir(&d).unwrap().next().is_none(), "{args:?}: nothing written");
-    }
-    // validate cannot check its frames: a warning, so `--strict` does not pass it silently.
-    let o = run(&["validate", "--strict", "--format", "json", s(&input)]);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(o.status.code(), Some(1), "{out}");
-    assert!(out.contains("PRIMITIVE_COMPRESSED") && out.contains("gltf-transform"), "{out}");
-    // Without --strict it passes, saying what it did not check.
-    assert_eq!(run(&["validate", s(&input)]).status.code(), Some(0));
+    assert_draco_decoded(&input, &validated_dir("real_draco"), &scratch_dir("real_draco"));
+    // Without --overwrite the decoded tangents are kept, and the file still leaves uncompressed.
+    let d = validated_dir("real_draco_kept");
+    let out = d.join("kept.gltf");
+    run_ok(&["tangents", s(&input), "-o", s(&out)]);
+    record_input(&out, &input, &[]);
+    assert!(!load(&out).json.to_string().contains("KHR_draco_mesh_compression"));
+    let d = scratch_dir("real_draco_bake");
+    run_ok(&["bake", s(&input), "-o", s(&d.join("b.glb"))]);
+    run_ok(&["inspect", s(&input)]);
 }
 
 /// The files `.ci/corpus.sh` made, or `None` (with a note) outside CI when there are none.
@@ -201,10 +220,6 @@ fn every_command_on_every_corpus_file_succeeds_or_says_why() {
             let mut args = vec!["tangents", s(f), "-o", s(&out), "-q"];
             args.extend(extra);
             let o = run(&args);
-            if draco {
-                assert_plain_refusal(&o, f, "KHR_draco_mesh_compression");
-                continue;
-            }
             assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
             // CI holds the output to its input's Khronos issues (.ci/validate-gltf.js).
             record_input(&out, f, &[]);
@@ -216,7 +231,6 @@ fn every_command_on_every_corpus_file_succeeds_or_says_why() {
         let o = run(&["bake", s(f), "-o", s(&out), "-q"]);
         match o.status.code() {
             Some(0) => record_input(&out, f, &[]),
-            _ if draco => assert_plain_refusal(&o, f, "KHR_draco_mesh_compression"),
             // Images another helper's decoder may not read yet: a plain refusal naming the format.
             _ => assert_plain_refusal(&o, f, ""),
         }
@@ -224,14 +238,13 @@ fn every_command_on_every_corpus_file_succeeds_or_says_why() {
         let o = run(&["preview", s(f), "-o", s(&png)]);
         match o.status.code() {
             Some(0) => assert!(png.exists()),
-            _ if draco => assert_plain_refusal(&o, f, "KHR_draco_mesh_compression"),
             _ => assert_plain_refusal(&o, f, ""),
         }
         let o = run(&["validate", "--format", "json", s(f)]);
         assert!(matches!(o.status.code(), Some(0 | 1)), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
-        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap();
         if draco {
-            assert!(report.to_string().contains("KHR_draco_mesh_compression"), "{stem}: says what it did not check");
+            assert_draco_decoded(f, &d, &scratch);
         }
         run_ok(&["inspect", s(f)]);
         // A correct map after glTF-Transform's JPEG or WebP coding passes strictly (issue 22);

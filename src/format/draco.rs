@@ -1,22 +1,411 @@
-//! KHR_draco_mesh_compression: bumpbake has no Draco decoder (see docs/dependencies.md for why).
-//! A Draco primitive's accessors hold no data of their own, so reading one is an error that says
-//! how to get an uncompressed file; primitives nothing reads pass through the writer untouched.
+//! KHR_draco_mesh_compression, decoded right after parsing (after EXT_meshopt_compression, whose
+//! views could hold a Draco stream): each compressed primitive's stream is decoded with
+//! `draco-core` (pure Rust, `unsafe` forbidden; see docs/dependencies.md for the campaign that
+//! chose it), its attributes and faces are written into a new buffer in the types the primitive's
+//! accessors declare, the accessors are pointed at them, and the extension leaves the document.
+//! Every later stage sees plain accessors, and the writer writes the file uncompressed.
 
-use crate::scene::{PrimRef, Scene};
+use crate::error::{Error, Result};
+use crate::scene::accessor::{component_count, component_size, FLOAT, UNSIGNED_INT, UNSIGNED_SHORT};
+use crate::scene::as_index;
+use draco_core::{DataType, DecodeLimits, DecoderBuffer, ErrorKind, Mesh, MeshDecoder, PointAttribute, PointIndex};
+use serde_json::{json, Value};
+use std::collections::BTreeMap;
+use std::path::Path;
 
 pub const EXT: &str = "KHR_draco_mesh_compression";
 
-/// What to run to get a file bumpbake can read. glTF-Transform decodes Draco on reading and its
-/// `copy` writes the result uncompressed (checked with `@gltf-transform/cli` 4.5.1; gltfpack 1.3
-/// cannot read Draco at all).
-pub const WAY_OUT: &str =
-    "decode it first with `npx @gltf-transform/cli copy IN.glb OUT.glb`, which writes it uncompressed";
+const TRIANGLES: u64 = 4;
+const POINTS: u64 = 0;
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 
-/// Why the primitive's geometry cannot be read, if it is Draco-compressed.
-pub fn why_unreadable(scene: &Scene, r: PrimRef) -> Option<String> {
-    scene.prim_json(r).pointer("/extensions/KHR_draco_mesh_compression")?;
-    Some(format!(
-        "mesh {} primitive {} is compressed with {EXT}, which bumpbake cannot decode; {WAY_OUT}",
-        r.mesh, r.primitive
-    ))
+/// Decodes every Draco-compressed primitive of `json` into a new buffer appended to `buffers`,
+/// and removes the extension. Returns whether there was anything to decode.
+pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut Vec<Vec<u8>>) -> Result<bool> {
+    let mut prims = Vec::new();
+    for (m, mesh) in json.get("meshes").and_then(|m| m.as_array()).into_iter().flatten().enumerate() {
+        for (p, prim) in mesh.get("primitives").and_then(|p| p.as_array()).into_iter().flatten().enumerate() {
+            if prim.pointer("/extensions/KHR_draco_mesh_compression").is_some() {
+                prims.push((m, p));
+            }
+        }
+    }
+    if prims.is_empty() {
+        return Ok(false);
+    }
+    let mut out = Out { buffer: buffers.len(), bytes: Vec::new(), written: BTreeMap::new() };
+    for (m, p) in prims {
+        let bad = |msg: String| Error::input(path, format!("mesh {m} primitive {p}: {msg}"));
+        let prim = json["meshes"][m]["primitives"][p].clone();
+        let ext = &prim["extensions"][EXT];
+        let stream = stream_bytes(json, buffers, ext).map_err(|e| bad(format!("{EXT}: {e}")))?;
+        let mesh = decode_stream(stream, limits(json, &prim))
+            .map_err(|e| bad(format!("{EXT} stream could not be decoded ({e})")))?;
+        let prim = out.place(json, &prim, &mesh).map_err(|e| bad(format!("{EXT}: {e}")))?;
+        json["meshes"][m]["primitives"][p] = prim;
+    }
+    if !out.bytes.is_empty() {
+        crate::scene::array_mut(json, "buffers").push(json!({ "byteLength": out.bytes.len() }));
+        buffers.push(out.bytes);
+    }
+    for key in ["extensionsUsed", "extensionsRequired"] {
+        if let Some(list) = json.get_mut(key).and_then(|l| l.as_array_mut()) {
+            list.retain(|e| e.as_str() != Some(EXT));
+            if list.is_empty() {
+                json.as_object_mut().map(|o| o.remove(key));
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// Decodes one Draco stream, stopping at `limits`.
+pub fn decode_stream(stream: &[u8], limits: DecodeLimits) -> std::result::Result<Mesh, String> {
+    let mut mesh = Mesh::new();
+    MeshDecoder::new()
+        .decode(&mut DecoderBuffer::new(stream).with_limits(limits), &mut mesh)
+        .map_err(|e| match e.kind() {
+            ErrorKind::LimitExceeded => format!("it holds more than the accessors declare: {}", e.message()),
+            _ => e.to_string(),
+        })
+        .map_err(|e| e.replace(['\n', '\r'], " "))?;
+    Ok(mesh)
+}
+
+/// Decodes a stream and reads every value of every attribute and every face as [`decode_all`]
+/// does: what the fuzz target and the mutation campaign run. Returns the point and face counts.
+pub fn decode_and_read(stream: &[u8]) -> std::result::Result<(usize, usize), String> {
+    let mesh = decode_stream(stream, DecodeLimits::fuzzing())?;
+    let n = mesh.num_points();
+    for a in 0..mesh.num_attributes() {
+        let attr = mesh.try_attribute(a).map_err(|e| e.to_string())?;
+        let comps = attr.num_components() as usize;
+        let mut sink = Vec::with_capacity(n * comps * 4);
+        for_each_value(attr, n, comps, &mut |v| {
+            sink.extend_from_slice(&(v as f32).to_le_bytes());
+            Ok(())
+        })?;
+    }
+    faces(&mesh)?;
+    Ok((n, mesh.num_faces()))
+}
+
+/// The stream may not decode to more than its primitive's accessors declare: a stream that does is
+/// refused anyway, and the ceilings let the decoder refuse it before allocating what it claims.
+fn limits(json: &Value, prim: &Value) -> DecodeLimits {
+    let count = |i: Option<&Value>| {
+        i.and_then(as_index).and_then(|i| json.pointer(&format!("/accessors/{i}/count"))).and_then(|c| c.as_u64())
+    };
+    let attrs = prim.get("attributes").and_then(|a| a.as_object());
+    let points = attrs.into_iter().flat_map(|a| a.values()).filter_map(|i| count(Some(i))).max();
+    let mut l = DecodeLimits::default();
+    if let Some(n) = points {
+        l = l.with_max_points(n);
+    }
+    if let Some(n) = count(prim.get("indices")) {
+        l = l.with_max_faces(n / 3);
+    }
+    l
+}
+
+/// The bytes of the stream's buffer view, checked against its buffer.
+fn stream_bytes<'a>(json: &Value, buffers: &'a [Vec<u8>], ext: &Value) -> std::result::Result<&'a [u8], String> {
+    let v = ext.get("bufferView").and_then(as_index).ok_or("no bufferView")?;
+    let view = json.pointer(&format!("/bufferViews/{v}")).ok_or(format!("bufferView {v} does not exist"))?;
+    let b = view.get("buffer").and_then(as_index).ok_or(format!("bufferView {v} has no buffer"))?;
+    let off = view.get("byteOffset").and_then(|o| o.as_u64()).unwrap_or(0) as usize;
+    let len = view.get("byteLength").and_then(|o| o.as_u64()).ok_or(format!("bufferView {v} has no byteLength"))?;
+    buffers
+        .get(b)
+        .and_then(|buf| buf.get(off..off.checked_add(len as usize)?))
+        .ok_or(format!("bufferView {v} runs past the end of buffer {b}"))
+}
+
+/// The decoded data, accumulated into one new buffer.
+struct Out {
+    buffer: usize,
+    bytes: Vec<u8>,
+    /// Accessor already given data by a decoded primitive -> where in `bytes` that data lies.
+    written: BTreeMap<usize, std::ops::Range<usize>>,
+}
+
+impl Out {
+    /// The primitive with its accessors pointed at the decoded data and without the extension.
+    fn place(&mut self, json: &mut Value, prim: &Value, mesh: &Mesh) -> std::result::Result<Value, String> {
+        let mut prim = prim.clone();
+        let ext = prim["extensions"][EXT].clone();
+        let ids = ext.get("attributes").and_then(|a| a.as_object()).ok_or("no attributes")?;
+        let n = mesh.num_points();
+        for (name, id) in ids {
+            let Some(acc) = prim.get("attributes").and_then(|a| a.get(name)) else {
+                continue;
+            };
+            let acc = as_index(acc).ok_or(format!("attribute {name} names no accessor"))?;
+            let id = id.as_u64().and_then(|i| u32::try_from(i).ok()).ok_or(format!("attribute {name}: bad id"))?;
+            let attr =
+                mesh.attribute_by_unique_id(id).ok_or(format!("attribute {name}: the stream has no attribute {id}"))?;
+            let (ct, comps, count) = layout(json, acc)?;
+            if count != n {
+                return Err(format!("the stream decodes {n} points, but accessor {acc} ({name}) declares {count}"));
+            }
+            if attr.num_components() as usize != comps {
+                return Err(format!(
+                    "attribute {name}: the stream has {} components, accessor {acc} declares {comps}",
+                    attr.num_components()
+                ));
+            }
+            let size = component_size(ct).unwrap_or(4);
+            // Each element of a vertex attribute starts on a 4-byte boundary (glTF 3.6.2.4).
+            let stride = (comps * size).next_multiple_of(4);
+            let pad = stride - comps * size;
+            let mut data = Vec::with_capacity(n * stride);
+            let float = !attr.data_type().is_integral();
+            let mut bounds = Bounds::new(comps);
+            for_each_value(attr, n, comps, &mut |v| {
+                bounds.add(put(&mut data, ct, v, float)?);
+                if bounds.at == 0 {
+                    data.extend_from_slice(&[0; 3][..pad]);
+                }
+                Ok(())
+            })
+            .map_err(|e| format!("attribute {name} (accessor {acc}): {e}"))?;
+            let acc = self.assign(json, acc, data, ARRAY_BUFFER, (pad != 0).then_some(stride));
+            bounds.replace(json, acc, ct);
+            prim["attributes"][name] = json!(acc);
+        }
+        let mode = prim.get("mode").and_then(|m| m.as_u64()).unwrap_or(TRIANGLES);
+        let faces = faces(mesh)?;
+        match mode {
+            TRIANGLES => {
+                let (acc, ct) = match prim.get("indices") {
+                    Some(i) => {
+                        let acc = as_index(i).ok_or("indices names no accessor")?;
+                        let (ct, comps, count) = layout(json, acc)?;
+                        if comps != 1 || !matches!(ct, 5121 | UNSIGNED_SHORT | UNSIGNED_INT) {
+                            return Err(format!("indices accessor {acc} is not unsigned integer scalars"));
+                        }
+                        if count != faces.len() {
+                            return Err(format!(
+                                "the stream decodes {} triangles, but indices accessor {acc} declares {count} indices",
+                                faces.len() / 3
+                            ));
+                        }
+                        (Some(acc), ct)
+                    }
+                    None if n < 65535 => (None, UNSIGNED_SHORT),
+                    None => (None, UNSIGNED_INT),
+                };
+                let mut data = Vec::with_capacity(faces.len() * component_size(ct).unwrap_or(4));
+                let mut bounds = Bounds::new(1);
+                for &i in &faces {
+                    bounds.add(put(&mut data, ct, i as f64, false).map_err(|e| format!("indices: {e}"))?);
+                }
+                let acc = match acc {
+                    Some(acc) => self.assign(json, acc, data, ELEMENT_ARRAY_BUFFER, None),
+                    None => {
+                        let accs = crate::scene::array_mut(json, "accessors");
+                        accs.push(json!({ "componentType": ct, "count": faces.len(), "type": "SCALAR" }));
+                        let acc = accs.len() - 1;
+                        self.assign(json, acc, data, ELEMENT_ARRAY_BUFFER, None)
+                    }
+                };
+                bounds.replace(json, acc, ct);
+                prim["indices"] = json!(acc);
+            }
+            POINTS if faces.is_empty() && prim.get("indices").is_none() => {}
+            _ => return Err(format!("mode {mode} with {} decoded triangles is not supported", faces.len() / 3)),
+        }
+        let exts = prim["extensions"].as_object_mut().ok_or("extensions is not an object")?;
+        exts.remove(EXT);
+        if exts.is_empty() {
+            prim.as_object_mut().map(|o| o.remove("extensions"));
+        }
+        Ok(prim)
+    }
+
+    /// Points accessor `acc` at `data` in a new buffer view, and returns the accessor to use: `acc`,
+    /// or a copy of it when an earlier primitive gave `acc` different data (two primitives sharing
+    /// an accessor, which only odd files do).
+    fn assign(&mut self, json: &mut Value, acc: usize, data: Vec<u8>, target: u32, stride: Option<usize>) -> usize {
+        let acc = match self.written.get(&acc) {
+            Some(r) if self.bytes[r.clone()] == data[..] => return acc,
+            Some(_) => {
+                let copy = json["accessors"][acc].clone();
+                let accs = crate::scene::array_mut(json, "accessors");
+                accs.push(copy);
+                accs.len() - 1
+            }
+            None => acc,
+        };
+        self.bytes.resize(self.bytes.len().next_multiple_of(4), 0);
+        let at = self.bytes.len();
+        let mut view = json!({
+            "buffer": self.buffer,
+            "byteOffset": at,
+            "byteLength": data.len(),
+            "target": target,
+        });
+        if let Some(s) = stride {
+            view["byteStride"] = json!(s);
+        }
+        self.bytes.extend_from_slice(&data);
+        let views = crate::scene::array_mut(json, "bufferViews");
+        views.push(view);
+        let v = views.len() - 1;
+        let a = &mut json["accessors"][acc];
+        a["bufferView"] = json!(v);
+        a.as_object_mut().map(|o| o.remove("byteOffset"));
+        self.written.insert(acc, at..at + data.len());
+        acc
+    }
+}
+
+/// An accessor's componentType, component count and count.
+fn layout(json: &Value, acc: usize) -> std::result::Result<(u32, usize, usize), String> {
+    let a = json.pointer(&format!("/accessors/{acc}")).ok_or(format!("accessor {acc} does not exist"))?;
+    let ct = a.get("componentType").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
+    let ty = a.get("type").and_then(|t| t.as_str()).unwrap_or("");
+    let comps = match component_count(ty) {
+        Some(c) if component_size(ct).is_some() && !ty.starts_with("MAT") => c,
+        _ => return Err(format!("accessor {acc} (componentType {ct}, type '{ty}') cannot hold decoded Draco data")),
+    };
+    let count = a.get("count").and_then(|c| c.as_u64()).ok_or(format!("accessor {acc} has no count"))?;
+    Ok((ct, comps, count as usize))
+}
+
+/// Every component of every point of `attr`, in point order, as a number.
+fn for_each_value(
+    attr: &PointAttribute,
+    points: usize,
+    comps: usize,
+    f: &mut dyn FnMut(f64) -> std::result::Result<(), String>,
+) -> std::result::Result<(), String> {
+    let dt = attr.data_type();
+    let width = dt.byte_length();
+    if width == 0 {
+        return Err("the stream's attribute has no data type".into());
+    }
+    let stride = usize::try_from(attr.byte_stride()).map_err(|_| "the stream's attribute has a negative stride")?;
+    let data = attr.buffer().data();
+    for p in 0..points {
+        let value = attr.mapped_index(PointIndex(p as u32)).0 as usize;
+        let at = (value < attr.size())
+            .then(|| value.checked_mul(stride))
+            .flatten()
+            .ok_or(format!("point {p} has no value"))?;
+        for c in 0..comps {
+            let bytes = at
+                .checked_add(c * width)
+                .and_then(|s| data.get(s..s + width))
+                .ok_or(format!("point {p} lies outside the decoded data"))?;
+            f(number(dt, bytes))?;
+        }
+    }
+    Ok(())
+}
+
+fn number(dt: DataType, b: &[u8]) -> f64 {
+    let a = |n: usize| -> [u8; 8] {
+        let mut w = [0; 8];
+        w[..n].copy_from_slice(&b[..n]);
+        w
+    };
+    match dt {
+        DataType::Int8 => b[0] as i8 as f64,
+        DataType::Uint8 | DataType::Bool => b[0] as f64,
+        DataType::Int16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+        DataType::Uint16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+        DataType::Int32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        DataType::Uint32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        DataType::Int64 => i64::from_le_bytes(a(8)) as f64,
+        DataType::Uint64 => u64::from_le_bytes(a(8)) as f64,
+        DataType::Float32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        DataType::Float64 => f64::from_le_bytes(a(8)),
+        DataType::Invalid => 0.0,
+    }
+}
+
+/// Appends `v` as component type `ct` and returns the value stored. Integers are copied only when
+/// they fit; floats go only to float accessors (rounding them to integers would invent a
+/// quantization the file did not ask for).
+fn put(out: &mut Vec<u8>, ct: u32, v: f64, from_float: bool) -> std::result::Result<f64, String> {
+    if ct == FLOAT {
+        out.extend_from_slice(&(v as f32).to_le_bytes());
+        return Ok(v as f32 as f64);
+    }
+    if from_float {
+        return Err(format!("the stream holds floats, the accessor declares componentType {ct}"));
+    }
+    let (lo, hi) = match ct {
+        5120 => (i8::MIN as f64, i8::MAX as f64),
+        5121 => (0.0, u8::MAX as f64),
+        5122 => (i16::MIN as f64, i16::MAX as f64),
+        UNSIGNED_SHORT => (0.0, u16::MAX as f64),
+        _ => (0.0, u32::MAX as f64),
+    };
+    if !(lo..=hi).contains(&v) {
+        return Err(format!("value {v} does not fit componentType {ct}"));
+    }
+    match ct {
+        5120 => out.push(v as i8 as u8),
+        5121 => out.push(v as u8),
+        5122 => out.extend_from_slice(&(v as i16).to_le_bytes()),
+        UNSIGNED_SHORT => out.extend_from_slice(&(v as u16).to_le_bytes()),
+        _ => out.extend_from_slice(&(v as u32).to_le_bytes()),
+    }
+    Ok(v)
+}
+
+/// Per-component bounds of the values written. An accessor's `min` and `max` were computed by the
+/// encoder from the data before quantization, which the decoded data can exceed; glTF wants the
+/// bounds of the data the file holds.
+struct Bounds {
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    at: usize,
+}
+
+impl Bounds {
+    fn new(comps: usize) -> Bounds {
+        Bounds { lo: vec![f64::INFINITY; comps], hi: vec![f64::NEG_INFINITY; comps], at: 0 }
+    }
+
+    fn add(&mut self, v: f64) {
+        self.lo[self.at] = self.lo[self.at].min(v);
+        self.hi[self.at] = self.hi[self.at].max(v);
+        self.at = (self.at + 1) % self.lo.len();
+    }
+
+    /// Replaces the bounds accessor `acc` declares, if it declares any.
+    fn replace(&self, json: &mut Value, acc: usize, ct: u32) {
+        let a = &mut json["accessors"][acc];
+        if (a.get("min").is_none() && a.get("max").is_none()) || self.lo.iter().any(|v| !v.is_finite()) {
+            return;
+        }
+        let list = |v: &[f64]| -> Value {
+            if ct == FLOAT {
+                json!(v)
+            } else {
+                json!(v.iter().map(|&x| x as i64).collect::<Vec<_>>())
+            }
+        };
+        a["min"] = list(&self.lo);
+        a["max"] = list(&self.hi);
+    }
+}
+
+/// The faces as a flat index list, each index checked against the point count.
+fn faces(mesh: &Mesh) -> std::result::Result<Vec<u32>, String> {
+    let n = mesh.num_points();
+    let mut out = Vec::with_capacity(mesh.num_faces() * 3);
+    for f in mesh.faces() {
+        for p in f {
+            if p.0 as usize >= n {
+                return Err(format!("a face names point {}, past the {n} points", p.0));
+            }
+            out.push(p.0);
+        }
+    }
+    Ok(out)
 }

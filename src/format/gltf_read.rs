@@ -1,6 +1,6 @@
 //! Reading `.gltf` and `.glb` into a [`Scene`], checking every reference before it is followed.
 
-use super::{meshopt, uri};
+use super::{draco, meshopt, uri};
 use crate::error::{Error, Result};
 use crate::scene::{as_index, ReadOptions, Scene, SourceFormat};
 use serde_json::Value;
@@ -136,6 +136,9 @@ fn build(
     let mut notes = Vec::new();
     if meshopt::decode_all(path, &mut json, &mut buffers)? {
         notes.push(format!("{}: decoded; the output is written without it (uncompressed)", meshopt::EXT));
+    }
+    if draco::decode_all(path, &mut json, &mut buffers)? {
+        notes.push(format!("{}: decoded; the output is written without it (uncompressed)", draco::EXT));
     }
     let scene = Scene {
         json,

@@ -2,7 +2,8 @@
 //!
 //! Each reader hands over the same [`Scene`] (glTF JSON + buffers, OBJ converted on reading) and
 //! the image reader the same decoded image, so no stage learns where a mesh or a texture came
-//! from. Compression (meshopt) is decoded right after parsing, as gltfpack's `parsegltf.cpp` does.
+//! from. Compression (meshopt, Draco) is decoded right after parsing, as gltfpack's `parsegltf.cpp`
+//! does for meshopt.
 
 pub mod dequant;
 pub mod draco;
@@ -103,9 +104,6 @@ impl Scene {
 
     /// Reads a primitive's streams, indices and morph targets.
     pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
-        if let Some(why) = draco::why_unreadable(self, r) {
-            return Err(self.err(why));
-        }
         self.declared_primitive(r)
     }
 }

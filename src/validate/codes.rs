@@ -86,11 +86,11 @@ codes! {
     /// A primitive whose data cannot be read: a buffer without data, an index past the vertex
     /// count, attributes of unequal counts.
     PRIMITIVE_UNREADABLE = Error, "repair the file's data (the message names what is wrong); every bumpbake command that reads this primitive refuses it";
-    /// A primitive the checks cannot read (not triangles, compressed).
-    PRIMITIVE_NOT_CHECKED = Info, "decompress or triangulate the mesh to have it checked";
-    /// A compressed primitive (KHR_draco_mesh_compression) whose normal texture needs frames that
-    /// cannot be checked.
-    PRIMITIVE_COMPRESSED = Warning, "decompress it to have its frames checked: `npx @gltf-transform/cli copy IN.glb OUT.glb` writes Draco meshes uncompressed";
+    /// A primitive the checks cannot read (not triangles, no POSITION).
+    PRIMITIVE_NOT_CHECKED = Info, "triangulate the mesh (with a POSITION attribute) to have it checked";
+    /// No longer raised (Draco primitives are decoded on reading); kept so that `--deny`/`--allow`
+    /// naming it still parse.
+    PRIMITIVE_COMPRESSED = Warning, "nothing to do: Draco primitives are decoded and checked";
     /// The normal texture's image could not be decoded (format, missing file).
     NORMALMAP_UNREADABLE = Warning, "store the normal map as PNG, JPEG or WebP, or check that the file exists and is whole";
     /// The normal texture's image is in a format bumpbake does not decode (AVIF, a KTX2 block format, ...).

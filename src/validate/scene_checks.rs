@@ -23,19 +23,10 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         s.mesh = Some(r.mesh);
         s.primitive = Some(r.primitive);
         check_texcoords(scene, mats, r, &mut s);
-        // A compressed primitive whose normal map needs frames is a warning: its frames go
-        // unchecked, and `--strict` must not pass them silently.
-        let (code, why) = if let Some(why) = crate::format::draco::why_unreadable(scene, r) {
-            let code =
-                if view.tangent_need.is_some() { Code::PRIMITIVE_COMPRESSED } else { Code::PRIMITIVE_NOT_CHECKED };
-            (code, Some(why))
-        } else if !view.mode.has_triangles() {
-            (Code::PRIMITIVE_NOT_CHECKED, Some(format!("not triangles (mode {})", view.mode)))
-        } else {
-            (Code::PRIMITIVE_NOT_CHECKED, None)
-        };
-        if let Some(why) = why {
-            s.check(code, Some(Finding::new(code, 1, 1, "primitives", format!("not checked: {why}"))));
+        let code = Code::PRIMITIVE_NOT_CHECKED;
+        if !view.mode.has_triangles() {
+            let why = format!("not checked: not triangles (mode {})", view.mode);
+            s.check(code, Some(Finding::new(code, 1, 1, "primitives", why)));
             subjects.push((s, None));
             continue;
         }

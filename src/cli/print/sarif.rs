@@ -35,12 +35,10 @@ fn description(code: Code) -> &'static str {
         TRIANGLE_UV_DEGENERATE => "A triangle with zero area in the normal texture's UV space.",
         TRIANGLE_SLIVER => "A needle triangle (quality below 1e-3) with unstable tangents.",
         NODE_MIRRORED => "A node shows a mesh through a negative-determinant transform (a mirrored instance).",
-        PRIMITIVE_COMPRESSED => {
-            "A primitive whose material needs tangents is Draco-compressed: its frames cannot be checked."
-        }
         NORMAL_NOT_UNIT => "NORMAL values that are zero, not finite, or not unit length.",
         PRIMITIVE_UNREADABLE => "A primitive whose data cannot be read (missing buffer data, index out of range).",
-        PRIMITIVE_NOT_CHECKED => "A primitive the checks cannot read (not triangles, compressed, no POSITION).",
+        PRIMITIVE_COMPRESSED => "No longer raised: Draco-compressed primitives are decoded and checked like any other.",
+        PRIMITIVE_NOT_CHECKED => "A primitive the checks cannot read (not triangles, no POSITION).",
         NORMALMAP_UNREADABLE => "A material's normal-texture image could not be read or decoded.",
         NORMALMAP_NOT_DECODED => {
             "A normal-map image in a format bumpbake does not decode (AVIF, block-compressed KTX2): not checked."
