@@ -121,7 +121,7 @@ fn raw_view(g: &mut Gltf, bytes: &[u8]) -> usize {
 
 /// The mutants per fixture when `BUMPBAKE_MUTANTS` is unset. A budget under the strata of a
 /// fixture never drops a stratum: each keeps one mutant whatever the budget.
-const DEFAULT_BUDGET: usize = 200;
+const DEFAULT_BUDGET: usize = 150;
 /// preview takes one input, so a process per mutant: in a sample it sees every stratum's first
 /// mutant and one in this many of the others.
 const PREVIEW_STRIDE: usize = 3;
@@ -543,20 +543,27 @@ fn check(cmd: Cmd, dir: &Path, files: &[String], ms: &[Mutant], rel: &str) -> Ve
         found.sort();
         return found;
     }
-    let run = run_in(dir, &cmd.args(files, &out), false);
+    let mut files: Vec<String> = files.to_vec();
+    let mut run = run_in(dir, &cmd.args(&files, &out), false);
     if crash(cmd, &run).is_some() {
         let mut idx: Vec<usize> = (0..files.len()).collect();
-        for (i, crash, site) in culprits(cmd, dir, files, &mut idx, &out) {
-            problems.push(culprit(rel, cmd, &ms[i], &crash, &site));
+        let found = culprits(cmd, dir, &files, &mut idx, &out);
+        if found.is_empty() {
+            return vec![format!("{rel}: {}: the batch crashed but no single mutant does", cmd.name())];
         }
-        if problems.is_empty() {
-            problems.push(format!("{rel}: {}: the batch crashed but no single mutant does", cmd.name()));
+        let crashed: BTreeSet<usize> = found.iter().map(|(i, ..)| *i).collect();
+        problems.extend(found.iter().map(|(i, crash, site)| culprit(rel, cmd, &ms[*i], crash, site)));
+        // The others still owe their records: the batch runs again without the crashing ones.
+        files = files.into_iter().enumerate().filter(|(i, _)| !crashed.contains(i)).map(|(_, f)| f).collect();
+        run = run_in(dir, &cmd.args(&files, &out), false);
+        if let Some(c) = crash(cmd, &run) {
+            problems.push(format!("{rel}: {}: the batch crashed again without its crashing mutants: {c}", cmd.name()));
+            return problems;
         }
-        return problems;
     }
     let judged = match cmd {
-        Cmd::Validate => judge_validate(&run, files),
-        _ => judge_records(cmd, &run, files),
+        Cmd::Validate => judge_validate(&run, &files),
+        _ => judge_records(cmd, &run, &files),
     };
     problems.extend(judged.into_iter().map(|p| format!("{rel}: {}: {p}", cmd.name())));
     problems
