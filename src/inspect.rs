@@ -153,7 +153,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
         let by = need.as_ref().ok().and(view.tangent_need.as_ref());
         // Listing reads the JSON; whether the data can be read is the reading rule's answer,
         // the same every other command gets.
-        let error = scene.declared_primitive(r).err().map(|e| match e {
+        let error = scene.primitive(r).err().map(|e| match e {
             crate::Error::Input { msg, .. } => msg,
             other => other.to_string(),
         });

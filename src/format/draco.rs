@@ -37,13 +37,16 @@ pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut Vec<Vec<u8>>) -> 
     let mut out = Out { buffer: buffers.len(), bytes: Vec::new(), written: BTreeMap::new() };
     for (m, p) in prims {
         let bad = |msg: String| Error::input(path, format!("mesh {m} primitive {p}: {msg}"));
-        let prim = json["meshes"][m]["primitives"][p].clone();
-        let ext = &prim["extensions"][EXT];
+        let at = format!("/meshes/{m}/primitives/{p}");
+        let prim = json.pointer(&at).cloned().unwrap_or_default();
+        let ext = prim.pointer(&format!("/extensions/{EXT}")).unwrap_or(&Value::Null);
         let stream = stream_bytes(json, buffers, ext).map_err(|e| bad(format!("{EXT}: {e}")))?;
         let mesh = decode_stream(stream, limits(json, &prim))
             .map_err(|e| bad(format!("{EXT} stream could not be decoded ({e})")))?;
         let prim = out.place(json, &prim, &mesh).map_err(|e| bad(format!("{EXT}: {e}")))?;
-        json["meshes"][m]["primitives"][p] = prim;
+        if let Some(slot) = json.pointer_mut(&at) {
+            *slot = prim;
+        }
     }
     if !out.bytes.is_empty() {
         crate::scene::array_mut(json, "buffers").push(json!({ "byteLength": out.bytes.len() }));
@@ -134,7 +137,7 @@ impl Out {
     /// The primitive with its accessors pointed at the decoded data and without the extension.
     fn place(&mut self, json: &mut Value, prim: &Value, mesh: &Mesh) -> std::result::Result<Value, String> {
         let mut prim = prim.clone();
-        let ext = prim["extensions"][EXT].clone();
+        let ext = prim.pointer(&format!("/extensions/{EXT}")).cloned().unwrap_or_default();
         let ids = ext.get("attributes").and_then(|a| a.as_object()).ok_or("no attributes")?;
         let n = mesh.num_points();
         for (name, id) in ids {
@@ -172,7 +175,9 @@ impl Out {
             .map_err(|e| format!("attribute {name} (accessor {acc}): {e}"))?;
             let acc = self.assign(json, acc, data, ARRAY_BUFFER, (pad != 0).then_some(stride));
             bounds.replace(json, acc, ct);
-            prim["attributes"][name] = json!(acc);
+            if let Some(attrs) = prim.get_mut("attributes") {
+                crate::scene::set_key(attrs, name, json!(acc));
+            }
         }
         let mode = prim.get("mode").and_then(|m| m.as_u64()).unwrap_or(TRIANGLES);
         let faces = faces(mesh)?;
@@ -211,12 +216,12 @@ impl Out {
                     }
                 };
                 bounds.replace(json, acc, ct);
-                prim["indices"] = json!(acc);
+                crate::scene::set_key(&mut prim, "indices", json!(acc));
             }
             POINTS if faces.is_empty() && prim.get("indices").is_none() => {}
             _ => return Err(format!("mode {mode} with {} decoded triangles is not supported", faces.len() / 3)),
         }
-        let exts = prim["extensions"].as_object_mut().ok_or("extensions is not an object")?;
+        let exts = prim.get_mut("extensions").and_then(Value::as_object_mut).ok_or("extensions is not an object")?;
         exts.remove(EXT);
         if exts.is_empty() {
             prim.as_object_mut().map(|o| o.remove("extensions"));
@@ -231,7 +236,7 @@ impl Out {
         let acc = match self.written.get(&acc) {
             Some(r) if self.bytes[r.clone()] == data[..] => return acc,
             Some(_) => {
-                let copy = json["accessors"][acc].clone();
+                let copy = json.pointer(&format!("/accessors/{acc}")).cloned().unwrap_or_default();
                 let accs = crate::scene::array_mut(json, "accessors");
                 accs.push(copy);
                 accs.len() - 1
@@ -247,15 +252,16 @@ impl Out {
             "target": target,
         });
         if let Some(s) = stride {
-            view["byteStride"] = json!(s);
+            crate::scene::set_key(&mut view, "byteStride", json!(s));
         }
         self.bytes.extend_from_slice(&data);
         let views = crate::scene::array_mut(json, "bufferViews");
         views.push(view);
         let v = views.len() - 1;
-        let a = &mut json["accessors"][acc];
-        a["bufferView"] = json!(v);
-        a.as_object_mut().map(|o| o.remove("byteOffset"));
+        if let Some(a) = json.pointer_mut(&format!("/accessors/{acc}")).and_then(Value::as_object_mut) {
+            a.insert("bufferView".into(), json!(v));
+            a.remove("byteOffset");
+        }
         self.written.insert(acc, at..at + data.len());
         acc
     }
@@ -379,7 +385,7 @@ impl Bounds {
 
     /// Replaces the bounds accessor `acc` declares, if it declares any.
     fn replace(&self, json: &mut Value, acc: usize, ct: u32) {
-        let a = &mut json["accessors"][acc];
+        let Some(a) = json.pointer_mut(&format!("/accessors/{acc}")) else { return };
         if (a.get("min").is_none() && a.get("max").is_none()) || self.lo.iter().any(|v| !v.is_finite()) {
             return;
         }
@@ -390,8 +396,8 @@ impl Bounds {
                 json!(v.iter().map(|&x| x as i64).collect::<Vec<_>>())
             }
         };
-        a["min"] = list(&self.lo);
-        a["max"] = list(&self.hi);
+        crate::scene::set_key(a, "min", list(&self.lo));
+        crate::scene::set_key(a, "max", list(&self.hi));
     }
 }
 

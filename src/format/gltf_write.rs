@@ -247,7 +247,7 @@ fn add_position_bounds(scene: &Scene, json: &mut Value) -> Result<()> {
     }
     for i in missing {
         let Some(acc) = json.pointer(&format!("/accessors/{i}")) else { continue };
-        // Accessors without data (Draco's) must carry their bounds already.
+        // An accessor without a bufferView is all zeros (or sparse): its bounds are for the file to give.
         if (acc.get("min").is_some() && acc.get("max").is_some()) || acc.get("bufferView").is_none() {
             continue;
         }

@@ -25,7 +25,7 @@ pub mod uri;
 pub use gltf_write::{write, WriteOptions, WriteStats};
 
 use crate::error::{Error, Result};
-use crate::scene::{as_index, PrimRef, Primitive, ReadOptions, Scene};
+use crate::scene::{as_index, ReadOptions, Scene};
 use std::path::{Path, PathBuf};
 
 impl Scene {
@@ -100,11 +100,6 @@ impl Scene {
         self.buffer_range(b, off, len)
             .map(<[u8]>::to_vec)
             .map_err(|why| self.err(format!("image {i}: bufferView {v} {why}")))
-    }
-
-    /// Reads a primitive's streams, indices and morph targets.
-    pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
-        self.declared_primitive(r)
     }
 }
 

@@ -264,10 +264,10 @@ impl Scene {
         PrimView::new(self, self.materials(), r).tangent_uvs().transform
     }
 
-    /// The primitive as its accessors declare it, for listing: the same as
-    /// [`primitive`](Self::primitive), except that a Draco-compressed primitive reads as the right
-    /// counts and formats with zeros for data (its accessors have no bytes of their own).
-    pub fn declared_primitive(&self, r: PrimRef) -> Result<Primitive> {
+    /// Reads a primitive's streams, indices and morph targets: the data half of the one reading
+    /// rule (docs/formats.md), so every command that reads a primitive refuses it with the same
+    /// message: accessor and index bounds, equal counts, finite positions and UVs.
+    pub fn primitive(&self, r: PrimRef) -> Result<Primitive> {
         let pj = self.prim_json(r);
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
         let attrs = pj

@@ -136,7 +136,7 @@ impl PrimView {
     }
 
     /// Reads the primitive's data (a triangle list when its mode is a surface), fails on what
-    /// cannot be read (Draco, broken accessors).
+    /// cannot be read (the reading rule of [`Scene::primitive`]).
     pub fn read(&self, scene: &Scene) -> Result<Geometry> {
         let p = scene.primitive(self.at)?;
         let mut primitive = if self.mode.has_triangles() { to_triangle_list(p) } else { p };
