@@ -29,24 +29,6 @@ fn bumpbake_tangents_output_is_clean() {
     assert_eq!(validate(&[s(&out), "--strict"]).0, 0);
 }
 
-/// A comparison that could not run is an error finding, never a file passed as checked. No input
-/// is known to make the engine panic, so the fault is injected (BUMPBAKE_INJECT_FAULT).
-#[test]
-fn a_failed_mikktspace_comparison_is_an_error_not_a_silence() {
-    let d = scratch_dir("validate_unchecked");
-    let input = write_prim(&d, "grid", &grid_prim(), true);
-    let o = bin()
-        .args(["validate", "--format", "json", "-q", s(&input)])
-        .env("BUMPBAKE_INJECT_FAULT", "mikktspace")
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
-    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_only(&r, "TANGENT_MIKK_UNCHECKED", "error");
-    // Without the fault the same file is clean.
-    assert_eq!(validate(&[s(&input)]).0, 0);
-}
-
 #[test]
 fn mirrored_uvs_after_tangents_are_clean() {
     let d = scratch_dir("validate_mirror_clean_in");

@@ -16,6 +16,17 @@ use glam::DVec3;
 
 /// The stored frames against regenerated MikkTSpace frames.
 pub fn check(d: &PrimData, max_angle_deg: f64, ex: &mut Explained, s: &mut Subject) {
+    check_against(d, max_angle_deg, ex, s, |mesh| mikk::generate(mesh, Engine::Fast))
+}
+
+/// [`check`] against the frames `engine` makes: the test of a failing engine gives its own.
+fn check_against(
+    d: &PrimData,
+    max_angle_deg: f64,
+    ex: &mut Explained,
+    s: &mut Subject,
+    engine: impl Fn(&TriMesh) -> Vec<Option<[f32; 4]>>,
+) {
     let (Some(t), Some(normals), Some(uvs)) = (&d.tangents, &d.normals, &d.uvs) else { return };
     // The engine trusts its input; give it finite values so no input can upset it.
     let clean3 = |v: &[f32; 3]| if v.iter().all(|x| x.is_finite()) { *v } else { [0.0; 3] };
@@ -27,15 +38,7 @@ pub fn check(d: &PrimData, max_angle_deg: f64, ex: &mut Explained, s: &mut Subje
     // linear in time and without the reference's recursion, which a high-valence vertex overflows.
     // The engine is not expected to fail on anything the reader accepts; if it does, that is a
     // bug to report, and the file must not pass as if it had been checked.
-    let engine = || {
-        // No input the reader accepts is known to make the engine panic, so the test of this
-        // path (tests/validate.rs) injects the fault.
-        if std::env::var_os("BUMPBAKE_INJECT_FAULT").is_some_and(|v| v == "mikktspace") {
-            panic!("fault injected into the MikkTSpace engine (BUMPBAKE_INJECT_FAULT)");
-        }
-        mikk::generate(&mesh, Engine::Fast)
-    };
-    let reference = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(engine)) {
+    let reference = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| engine(&mesh))) {
         Ok(r) => r,
         Err(_) => {
             let f = Finding::new(
@@ -170,5 +173,33 @@ mod tests {
         assert_eq!(super::percentile(&mut v, 0.99), 99.0);
         assert_eq!(super::percentile(&mut [5.0], 0.99), 5.0);
         assert_eq!(super::percentile(&mut [], 0.99), 0.0);
+    }
+}
+
+#[cfg(test)]
+mod engine_tests {
+    use super::*;
+    use crate::validate::frames::Quant;
+
+    /// A comparison that could not run is an error finding, never a primitive passed as checked.
+    /// No input the reader accepts is known to make the engine panic, so the test gives one that
+    /// does.
+    #[test]
+    fn a_failed_comparison_is_an_error_not_a_silence() {
+        let d = PrimData {
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            normals: Some(vec![[0.0, 0.0, 1.0]; 3]),
+            uvs: Some(vec![[0.0, 1.0], [1.0, 1.0], [0.0, 0.0]]),
+            tangents: Some(vec![[1.0, 0.0, 0.0, 1.0]; 3]),
+            quant: Quant::default(),
+            indices: vec![0, 1, 2],
+        };
+        let run = |engine: &dyn Fn(&TriMesh) -> Vec<Option<[f32; 4]>>| {
+            let mut s = Subject::new("primitive", "test");
+            check_against(&d, 1.0, &mut Explained::new(3, 3), &mut s, engine);
+            s.findings.iter().map(|f| f.code).collect::<Vec<_>>()
+        };
+        assert_eq!(run(&|_| panic!("a failing engine")), vec![Code::TANGENT_MIKK_UNCHECKED]);
+        assert_eq!(run(&|m| mikk::generate(m, Engine::Fast)), vec![]);
     }
 }
