@@ -26,8 +26,10 @@ impl Scene {
         removed.extend(self.unneeded_attributes(keep_bitangents));
         if !unknown {
             removed.extend(self.unused_materials());
-            removed.extend(self.dedupe_images());
-            removed.extend(self.unused_textures_images_samplers());
+            let duplicates = self.dedupe_images();
+            let unused = self.unused_textures_images_samplers(&duplicates);
+            removed.extend(duplicates);
+            removed.extend(unused);
         }
         Ok(removed)
     }
@@ -202,7 +204,9 @@ impl Scene {
         out
     }
 
-    fn unused_textures_images_samplers(&mut self) -> Vec<Removal> {
+    /// `duplicates` are the images [`Self::dedupe_images`] already listed (with their bytes): each
+    /// item is listed, and its bytes counted, once.
+    fn unused_textures_images_samplers(&mut self, duplicates: &[Removal]) -> Vec<Removal> {
         // Textures: what materials read.
         let mut out: Vec<Removal> = self
             .drop_unused("textures", refs::texture_refs)
@@ -216,9 +220,8 @@ impl Scene {
             .map(|i| (i, (self.image_name(i), self.image_bytes(i).map(|b| b.len()).unwrap_or(0))))
             .collect();
         for i in self.drop_unused("images", refs::image_refs) {
-            if let Some((name, bytes)) =
-                unshown.get(&i).filter(|_| !out.iter().any(|r| r.what.starts_with(&format!("image {i} "))))
-            {
+            let listed = |r: &Removal| r.what.starts_with(&format!("image {i} "));
+            if let Some((name, bytes)) = unshown.get(&i).filter(|_| !out.iter().chain(duplicates).any(listed)) {
                 out.push(Removal { what: format!("image {i} {name} (no texture shows it)"), bytes: *bytes });
             }
         }
@@ -283,5 +286,28 @@ mod tests {
             Some(&json!(0))
         );
         assert!(s.json.pointer("/materials/0/normalTexture/texCoord").is_none());
+    }
+
+    /// An image with the same bytes as another is listed once, its bytes counted once, though it
+    /// is both a duplicate and, after deduplication, shown by no texture.
+    #[test]
+    fn a_duplicate_image_is_listed_and_counted_once() {
+        let png = "data:image/png;base64,iVBORw0KGgo=";
+        let doc = json!({
+            "asset": { "version": "2.0" },
+            "images": [{ "uri": png }, { "uri": png }],
+            "textures": [{ "source": 0 }, { "source": 1 }],
+            "materials": [{ "normalTexture": { "index": 0 }, "occlusionTexture": { "index": 1 } }],
+            "meshes": [{ "primitives": [{ "attributes": { "TEXCOORD_0": 0 }, "material": 0 }] }],
+            "accessors": [{ "count": 0, "componentType": 5126, "type": "VEC2" }],
+        });
+        let mut s = Scene::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&doc).unwrap(), &ReadOptions::default())
+            .unwrap();
+        let removed = s.leave_out(false).unwrap();
+        let images: Vec<_> = removed.iter().filter(|r| r.what.starts_with("image ")).collect();
+        assert_eq!(images.len(), 1, "{removed:?}");
+        assert_eq!(images[0].bytes, 8);
+        assert_eq!(removed.iter().map(|r| r.bytes).sum::<usize>(), 8);
+        assert_eq!(s.array("images").len(), 1);
     }
 }
