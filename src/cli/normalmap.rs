@@ -1,6 +1,7 @@
 //! `bumpbake normalmap HEIGHT -o NORMAL`: parses, checks the numbers, shows progress on a
 //! terminal, and hands the rest to `bumpbake::normalmap::convert_file`.
 
+use super::args::{ChannelArg, ConventionArg, FilterArg, WrapArg};
 use bumpbake::batch;
 use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap};
 use bumpbake::progress::Reporter;
@@ -31,8 +32,8 @@ pub struct Args {
     #[arg(long, value_parser = ["png", "tif", "exr"], default_value = "png")]
     pub out_ext: String,
     /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
-    #[arg(long, value_enum, default_value_t = Channel::Luma)]
-    pub channel: Channel,
+    #[arg(long, value_enum, default_value_t = ChannelArg::from(Channel::default()))]
+    pub channel: ChannelArg,
     /// Strength S: how tall the whole black-to-white height range stands, in texels [default: 1].
     ///
     /// At 1, a slope from black to white across 100 texels tilts the normal by only 0.6°: right
@@ -48,14 +49,14 @@ pub struct Args {
     #[arg(long, value_name = "METRES", allow_negative_numbers = true, requires = "height_range")]
     pub texel_size: Option<f64>,
     /// Derivative filter (all estimate the true slope; see docs/normalmap.md).
-    #[arg(long, value_enum, default_value_t = Filter::default())]
-    pub filter: Filter,
+    #[arg(long, value_enum, default_value_t = FilterArg::from(Filter::default()))]
+    pub filter: FilterArg,
     /// What lies beyond the edges: repeat for tiling textures.
-    #[arg(long, value_enum, default_value_t = Wrap::Clamp)]
-    pub wrap: Wrap,
+    #[arg(long, value_enum, default_value_t = WrapArg::from(Wrap::default()))]
+    pub wrap: WrapArg,
     /// +Y up (opengl, glTF) or down (directx).
-    #[arg(long, value_enum, default_value_t = Convention::Opengl)]
-    pub convention: Convention,
+    #[arg(long, value_enum, default_value_t = ConventionArg::from(Convention::default()))]
+    pub convention: ConventionArg,
     /// Bits per PNG/TIFF sample: 8 or 16 (EXR is always float).
     #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["8", "16"]).map(|s| s.parse::<u8>().unwrap()))]
     pub bits: Option<u8>,
@@ -109,18 +110,19 @@ pub struct Converted {
 
 pub fn run(args: Args) -> Result<u8> {
     let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
-    let options = Options { strength: strength(&args)?, filter: args.filter, wrap: args.wrap, invert: args.invert };
+    let options =
+        Options { strength: strength(&args)?, filter: args.filter.into(), wrap: args.wrap.into(), invert: args.invert };
     let convert = |input: &Path, output: &Path| -> Result<Convert> {
         let format = nm::OutputFormat::from_path(output)?;
         Ok(Convert {
             input: input.to_path_buf(),
             output: output.to_path_buf(),
-            channel: args.channel,
+            channel: args.channel.into(),
             max_pixels: args.max_pixels,
             options,
             encode: EncodeOptions {
                 depth: format.depth(output, args.bits)?,
-                convention: args.convention,
+                convention: args.convention.into(),
                 alpha_height: args.alpha == Some(Alpha::Height),
             },
             png: nm::PngSettings::default(),

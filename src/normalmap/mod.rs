@@ -43,7 +43,7 @@ use serde::Serialize;
 /// How the height derivative is estimated. Every filter is scaled to the true derivative per
 /// texel; they differ in how well they follow high frequencies, how much they smooth noise and
 /// what they cost (see `docs/normalmap.md` for the measured table).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Filter {
     /// `[-1 0 1]/2`: sharpest 3-tap, no smoothing, most sensitive to noise.
@@ -87,7 +87,7 @@ impl Filter {
 }
 
 /// What lies beyond the image edge.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Wrap {
     /// The opposite edge: for tiling textures.
@@ -100,7 +100,7 @@ pub enum Wrap {
 }
 
 /// Which way `+Y` points in the encoded map.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Convention {
     /// `+Y` up (OpenGL, glTF, Blender): the project's convention.
@@ -116,6 +116,14 @@ impl Convention {
         match self {
             Convention::Opengl => 1.0,
             Convention::Directx => -1.0,
+        }
+    }
+
+    /// The words reports use for this convention.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Convention::Opengl => "OpenGL (+Y)",
+            Convention::Directx => "DirectX (-Y)",
         }
     }
 }

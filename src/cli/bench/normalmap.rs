@@ -22,7 +22,7 @@ pub struct BenchNormalmapArgs {
     pub pipeline_size: usize,
     /// Only these filters (repeatable); all by default.
     #[arg(long, value_enum)]
-    pub filter: Vec<Filter>,
+    pub filter: Vec<super::super::args::FilterArg>,
     /// Print JSON instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -36,7 +36,11 @@ pub fn run(a: BenchNormalmapArgs) -> Result<u8> {
         size: a.size,
         runs: a.runs,
         pipeline_size: a.pipeline_size,
-        filters: if a.filter.is_empty() { Filter::ALL.to_vec() } else { a.filter },
+        filters: if a.filter.is_empty() {
+            Filter::ALL.to_vec()
+        } else {
+            a.filter.into_iter().map(Filter::from).collect()
+        },
     };
     let report = bn::run(&cfg, &|m| eprintln!("bench: {m}"))?;
     if let Some(path) = &a.plot {
