@@ -52,7 +52,7 @@ pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings)
         convention: Convention::Opengl,
         alpha_height: false,
     };
-    let img = normalmap::encode_normals(&plane, &opts, &enc, None);
+    let img = normalmap::encode_normals(&plane, &opts, &enc, &crate::progress::Reporter::none());
     let warning = normalmap::Flatness::of_image(&img)
         .warning(&plane, opts.strength, multiplier)
         .map(|w| format!("{}: {w}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()));

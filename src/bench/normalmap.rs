@@ -8,6 +8,7 @@ use super::surfaces::{self, Surface};
 use crate::normalmap::{
     self as nm, Channel, Convert, Depth, EncodeOptions, Filter, HeightPlane, NormalImage, Options, PngSettings, Wrap,
 };
+use crate::progress::Reporter;
 use crate::{Error, Result};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -183,8 +184,8 @@ pub fn run(cfg: &Config, log: &dyn Fn(&str)) -> Result<Report> {
             let opts = Options { strength: s.strength as f32, filter, wrap: Wrap::Repeat, invert: false };
             let normals = nm::height_to_normal(&plane, &opts);
             let error = errors(&normals.data, &exact);
-            let mut img = nm::encode_normals(&plane, &opts, &ENC8, None);
-            let mut run = || nm::encode_normals_into(&plane, &opts, &ENC8, None, &mut img);
+            let mut img = nm::encode_normals(&plane, &opts, &ENC8, &Reporter::none());
+            let mut run = || nm::encode_normals_into(&plane, &opts, &ENC8, &Reporter::none(), &mut img);
             let t = median_ms(cfg.runs, &mut run);
             let t1 = single.install(|| median_ms(cfg.runs, &mut run));
             rows.push(Row {
@@ -285,7 +286,7 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
     let filter = Filter::default();
     let opts = Options { strength: 8.0, filter, wrap: Wrap::Clamp, invert: false };
     let plane: HeightPlane = nm::load_height(&input, Channel::Luma, u64::MAX)?;
-    let img: NormalImage = nm::encode_normals(&plane, &opts, &ENC8, None);
+    let img: NormalImage = nm::encode_normals(&plane, &opts, &ENC8, &Reporter::none());
     let runs = cfg.runs;
     let png = PngSettings::default();
 
@@ -295,7 +296,7 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
     let encode_ms = median_ms(runs, || drop(nm::png_bytes(&img, png).expect("encodes")));
     let write_ms = median_ms(runs, || crate::output::write_atomic(&output, &encoded).expect("writes"));
     let mut reused = img.clone();
-    let mut run = || nm::encode_normals_into(&plane, &opts, &ENC8, None, &mut reused);
+    let mut run = || nm::encode_normals_into(&plane, &opts, &ENC8, &Reporter::none(), &mut reused);
     let filter_ms = median_ms(runs, &mut run);
     let filter_ms_1t = one_thread().install(|| median_ms(runs, &mut run));
     let filter_cpu_ms_1t = one_thread().install(|| median_cpu_ms(runs, &mut run));
@@ -314,7 +315,7 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
     let mut stage_runs: Vec<(f64, Vec<(String, f64)>)> = Vec::new();
     let command_ms = median_ms(runs, || {
         let s = Instant::now();
-        let (t, _) = nm::convert_file(&convert, None).expect("converts");
+        let t = nm::convert_file(&convert, &Reporter::none()).expect("converts").timings_ms;
         stage_runs.push((s.elapsed().as_secs_f64(), t.stages));
     });
     stage_runs.sort_by(|a, b| a.0.total_cmp(&b.0));

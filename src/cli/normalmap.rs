@@ -3,7 +3,7 @@
 
 use super::args::{ChannelArg, ConventionArg, FilterArg, WrapArg};
 use bumpbake::batch;
-use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap};
+use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, Converted, EncodeOptions, Filter, Options, Wrap};
 use bumpbake::progress::Reporter;
 use bumpbake::{Error, Result};
 use clap::builder::TypedValueParser;
@@ -95,19 +95,6 @@ fn strength(args: &Args) -> Result<f32> {
     Ok(s)
 }
 
-/// What one conversion did.
-#[derive(serde::Serialize)]
-pub struct Converted {
-    pub input: PathBuf,
-    pub output: PathBuf,
-    pub timings_ms: bumpbake::timings::Timings,
-    /// A map that came out (nearly) flat.
-    pub warnings: Vec<String>,
-    /// Whether this is one of several inputs (the text then names the files).
-    #[serde(skip)]
-    pub batch: bool,
-}
-
 pub fn run(args: Args) -> Result<u8> {
     let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
     let options =
@@ -129,53 +116,14 @@ pub fn run(args: Args) -> Result<u8> {
         })
     };
     let results = if args.heights.len() == 1 {
-        // One map: a bar over its rows, for big maps on a terminal.
-        let bar = progress(&args);
-        let tick = |rows: usize| bar.tick(rows as u64);
-        let r = convert(&args.heights[0], &outputs[0]).and_then(|c| nm::convert_file(&c, Some(&tick)));
-        bar.finish();
-        vec![r]
+        let progress = args.batch.single_progress(1);
+        vec![convert(&args.heights[0], &outputs[0]).and_then(|c| nm::convert_file(&c, &progress))]
     } else {
         let opts = args.batch.options(args.heights.len());
         batch::run(&args.heights, &opts, |input| {
-            convert(input, super::args::paired(&args.heights, &outputs, input)).and_then(|c| nm::convert_file(&c, None))
+            let c = convert(input, super::args::paired(&args.heights, &outputs, input))?;
+            nm::convert_file(&c, &Reporter::none()).map(|r| Converted { batch: true, ..r })
         })?
     };
-    let records: Vec<Result<Converted>> = results
-        .into_iter()
-        .zip(args.heights.iter().zip(&outputs))
-        .map(|(r, (i, o))| {
-            r.map(|(t, w)| Converted {
-                input: i.clone(),
-                output: o.clone(),
-                timings_ms: t,
-                warnings: w.into_iter().collect(),
-                batch: args.heights.len() > 1,
-            })
-        })
-        .collect();
-    super::print::all(&args.heights, records, args.batch.json, args.batch.quiet)
-}
-
-/// Rows done, told to a bar on a terminal for maps big enough to wait for; nothing when piped or
-/// under CI.
-fn progress(args: &Args) -> Reporter {
-    if !super::progress::wanted(args.batch.progress, args.batch.quiet) {
-        return Reporter::none();
-    }
-    // The header is read again by the conversion; this costs microseconds and keeps the
-    // library free of terminal concerns.
-    let rows = image::ImageReader::open(&args.heights[0])
-        .ok()
-        .and_then(|r| r.with_guessed_format().ok())
-        .and_then(|r| r.into_dimensions().ok())
-        .filter(|(w, h)| (*w as u64) * (*h as u64) >= 4 << 20 && (*w as u64) * (*h as u64) <= args.max_pixels);
-    match rows {
-        Some((_, h)) => {
-            let bar = super::progress::reporter(true);
-            bar.start(&format!("normalmap {}", args.heights[0].display()), h as u64, "rows");
-            bar
-        }
-        None => Reporter::none(),
-    }
+    super::print::all(&args.heights, results, args.batch.json, args.batch.quiet)
 }

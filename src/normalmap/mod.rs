@@ -33,11 +33,12 @@ pub use filter::wrap_index;
 pub use height::{height_from_image, Channel, HeightPlane};
 pub use io::{
     colour_words, convert_file, decode_normal_image, image_bytes, load_height, load_normal_image, open_image,
-    png_bytes, write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
+    png_bytes, write_normal_image, Convert, Converted, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
 pub use relief::{steepest_slope, Flatness, Verdict, EXACT_FLAT_DEG, NEARLY_FLAT_DEG};
-pub use rows::{unit_normal, Progress};
+pub use rows::unit_normal;
 
+use crate::progress::Reporter;
 use serde::Serialize;
 
 /// How the height derivative is estimated. Every filter is scaled to the true derivative per
@@ -176,7 +177,7 @@ impl NormalPlane {
 }
 
 /// Float unit normals for every texel of `height` (OpenGL convention).
-pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: Progress) -> NormalPlane {
+pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: &Reporter) -> NormalPlane {
     let (w, h) = (height.width, height.height);
     let mut data = vec![[0.0f32; 3]; w * h];
     let s = opts.signed_strength();
@@ -198,5 +199,5 @@ pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: Progr
 
 /// The name other commands use: [`normals_from_height`] without progress.
 pub fn height_to_normal(height: &HeightPlane, opts: &Options) -> NormalPlane {
-    normals_from_height(height, opts, None)
+    normals_from_height(height, opts, &Reporter::none())
 }
