@@ -196,7 +196,6 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         matching: a.matching.into(),
         node: a.node.clone(),
         progress,
-        ..Default::default()
     }))
 }
 
