@@ -254,9 +254,11 @@ fn no_import_circle_but_parent_and_child() {
     // Tarjan's strongly connected components, iteratively simple enough for a few hundred files.
     let names: Vec<&String> = g.keys().collect();
     let idx: BTreeMap<&String, usize> = names.iter().enumerate().map(|(i, n)| (*n, i)).collect();
-    let adj: Vec<Vec<usize>> = names.iter().map(|n| g[*n].iter().filter_map(|t| idx.get(t).copied()).collect()).collect();
+    let adj: Vec<Vec<usize>> =
+        names.iter().map(|n| g[*n].iter().filter_map(|t| idx.get(t).copied()).collect()).collect();
     let n = names.len();
-    let (mut index, mut low, mut on, mut stack, mut next) = (vec![usize::MAX; n], vec![0; n], vec![false; n], vec![], 0);
+    let (mut index, mut low, mut on, mut stack, mut next) =
+        (vec![usize::MAX; n], vec![0; n], vec![false; n], vec![], 0);
     let mut sccs: Vec<Vec<usize>> = Vec::new();
     fn strong(
         v: usize,
