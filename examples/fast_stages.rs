@@ -1,6 +1,6 @@
 //! Per-stage timing of the fast MikkTSpace engine on the bench's wavy grid.
 //! `cargo run --release --example fast_stages -- 1000000 [threads]`
-use bumpbake::bench::tangents::{build, Surface};
+use bumpbake::analytic::tangents::{build, Surface};
 
 fn main() {
     let mut args = std::env::args().skip(1);

@@ -12,11 +12,13 @@
 //! - [`transfer`]: high-poly to low-poly normal-map baking (`bake --from`).
 //! - [`output`]: atomic writes, so that no failed run leaves a partial file.
 //! - [`progress`]: how long work reports its progress; the caller draws it (or not).
-//! - [`bench`](mod@bench): error against run time (`bumpbake bench ...`).
+//! - [`analytic`]: test meshes with exact answers, for `bumpbake bench` and the tests (feature
+//!   `analytic`).
 
+#[cfg(feature = "analytic")]
+pub mod analytic;
 pub mod bake;
 pub mod batch;
-pub mod bench;
 pub mod error;
 pub mod format;
 pub mod inspect;

@@ -1,6 +1,6 @@
 //! The fast engine's output must not depend on the number of threads.
 
-use bumpbake::bench::tangents::{build, Surface};
+use bumpbake::analytic::tangents::{build, Surface};
 use bumpbake::tangent::mikk::{generate, Engine};
 
 fn bits(v: &[Option<[f32; 4]>]) -> Vec<Option<[u32; 4]>> {

@@ -520,7 +520,7 @@ fn streamed_png_matches_the_in_memory_encoder_across_strips() {
             let filter = if f == "sobel" { nm::Filter::Sobel } else { nm::Filter::Spectral };
             let opts = nm::Options { strength: 3.0, filter, ..Default::default() };
             let enc = nm::EncodeOptions { depth, alpha_height: true, ..Default::default() };
-            let want = nm::encode_normals(&plane, &opts, &enc, None);
+            let want = nm::encode_normals(&plane, &opts, &enc, &bumpbake::progress::Reporter::none());
             let got = nm::load_normal_image(&out, nm::DEFAULT_MAX_PIXELS).unwrap();
             assert_eq!(got, want, "{bits}-bit {f}");
         }

@@ -1,5 +1,6 @@
 //! Progress reaches the caller through `bumpbake::progress`, with totals that add up: a recording
-//! `Progress` on an OBJ read, a batch of files and a `bake --from`. The library never draws.
+//! `Progress` on an OBJ read, a batch of files, a `bake --from` and a `normalmap` conversion. The
+//! library never draws.
 
 use bumpbake::bake::{BakeJob, MapSource};
 use bumpbake::batch::{self, BatchOptions};
@@ -138,6 +139,37 @@ fn bake_from_reports_both_reads_and_every_row() {
     let rows = ("bake --from".to_string(), 40, "rows".to_string(), 40);
     // LOW, then HIGH, then the rays.
     assert_eq!(rec.stages(), vec![read_stage.clone(), read_stage, rows]);
+}
+
+#[test]
+fn normalmap_reports_its_rows() {
+    use bumpbake::normalmap::{self as nm, Convert, EncodeOptions};
+    let dir = std::env::temp_dir().join(format!("bumpbake-progress-normalmap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/bumps.png");
+    let rows = image::image_dimensions(&input).unwrap().1 as u64;
+    let rec = Recording::default();
+    let progress = Reporter::new(rec.clone());
+    for output in ["n.png", "n.exr"] {
+        let output = dir.join(output);
+        let c = Convert {
+            input: input.clone(),
+            output: output.clone(),
+            channel: Default::default(),
+            max_pixels: nm::DEFAULT_MAX_PIXELS,
+            options: Default::default(),
+            encode: EncodeOptions {
+                depth: nm::OutputFormat::from_path(&output).unwrap().depth(&output, None).unwrap(),
+                ..Default::default()
+            },
+            png: Default::default(),
+        };
+        nm::convert_file(&c, &progress).unwrap();
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    // The streamed PNG and the whole-image EXR count the same rows.
+    let stage = (format!("normalmap {}", input.display()), rows, "rows".to_string(), rows);
+    assert_eq!(rec.stages(), vec![stage.clone(), stage]);
 }
 
 #[test]

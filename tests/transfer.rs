@@ -3,7 +3,7 @@
 //! meshes, grazing rays, mirrored UVs and thread counts.
 
 mod common;
-use bumpbake::bench::transfer::{evaluate, Evaluation, Mesh, Torus};
+use bumpbake::analytic::torus::{evaluate, Evaluation, Mesh, Torus};
 use common::*;
 use glam::DVec3;
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 //! plain pair's map (within one 8-bit level).
 
 mod common;
-use bumpbake::bench::transfer::{Mesh, Torus};
+use bumpbake::analytic::torus::{Mesh, Torus};
 use common::*;
 use glam::{Mat3, Mat4, Quat, Vec3};
 use serde_json::{json, Value};

@@ -52,7 +52,7 @@ pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings)
         convention: Convention::Opengl,
         alpha_height: false,
     };
-    let img = normalmap::encode_normals(&plane, &opts, &enc, None);
+    let img = normalmap::encode_normals(&plane, &opts, &enc, &crate::progress::Reporter::none());
     let warning = normalmap::Flatness::of_image(&img)
         .warning(&plane, opts.strength, multiplier)
         .map(|w| format!("{}: {w}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()));
@@ -74,9 +74,8 @@ pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -
     let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
     let img = normalmap::open_image(path, max_pixels)?;
     let (detected, confidence) = crate::validate::detect_convention(&img.to_rgb8());
-    let detected_dx = detected == crate::validate::Convention::DirectX;
-    // The same threshold validate reports a flipped green channel at.
-    let confident = confidence >= 0.5 && detected != crate::validate::Convention::Unknown;
+    let detected_dx = detected == Some(Convention::Directx);
+    let confident = confidence >= crate::validate::REPORT_CONFIDENCE && detected.is_some();
     let is_dx = match declared {
         Some(Convention::Directx) if confident && !detected_dx => {
             return Err(Error::input(path, format!("declared DirectX (-Y), but the map looks like OpenGL (+Y) (confidence {confidence:.2})")))
@@ -87,7 +86,11 @@ pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -
         Some(c) => c == Convention::Directx,
         None => detected_dx && confident,
     };
-    let check = ConventionCheck { detected: detected.describe().into(), confidence, converted: is_dx };
+    let check = ConventionCheck {
+        detected: crate::validate::describe_convention(detected).into(),
+        confidence,
+        converted: is_dx,
+    };
     let kind = crate::format::image::Kind::sniff(&bytes);
     let core = matches!(kind, crate::format::image::Kind::Png | crate::format::image::Kind::Jpeg);
     if !is_dx && core {

@@ -74,6 +74,12 @@ pub struct BakeReport {
 }
 
 pub fn run(job: &BakeJob) -> Result<BakeReport> {
+    run_from(job, Vec::new())
+}
+
+/// [`run`] with HIGH meshes already in memory for a [`MapSource::Transfer`] job
+/// ([`crate::transfer::bake_from`]).
+pub fn run_from(job: &BakeJob, high: Vec<crate::format::raw::RawMesh>) -> Result<BakeReport> {
     let mut t = Timings::default();
     let mut scene = t.time("read", || Scene::read(&job.mesh, &job.read))?;
     let mut deps = scene.dependencies();
@@ -97,7 +103,7 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
         MapSource::Transfer(ts) => {
             deps.extend(ts.highs.iter().chain(ts.cage.iter()).cloned());
             let mats: Vec<usize> = targets.iter().map(|m| m.material).collect();
-            let baked = t.time("transfer", || crate::transfer::bake_materials(&scene, &mats, ts))?;
+            let baked = t.time("transfer", || crate::transfer::bake_from(&scene, &mats, ts, high))?;
             baked.maps.iter().for_each(|(m, png)| maps::replace_normal_image(&mut scene, *m, png));
             Some((baked.report, baked.files))
         }

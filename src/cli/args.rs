@@ -2,8 +2,95 @@
 //! and how the batch runs (`print` prints its results).
 
 use bumpbake::batch::{self, BatchOptions};
+use bumpbake::normalmap::{Channel, Convention, Filter, Wrap};
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
+
+/// A command-line twin of a library enum, mapped both ways by exhaustive matches: the library
+/// stays free of clap, a variant added there fails to compile here until it has a spelling, and
+/// the twin's doc comments are the help text of its values.
+macro_rules! arg_enum {
+    ($(#[$m:meta])* $vis:vis enum $name:ident => $lib:ident {
+        $($(#[$vm:meta])* $var:ident => $lv:ident),+ $(,)?
+    }) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+        $vis enum $name {
+            $($(#[$vm])* $var),+
+        }
+
+        impl From<$name> for $lib {
+            fn from(a: $name) -> $lib {
+                match a {
+                    $($name::$var => $lib::$lv),+
+                }
+            }
+        }
+
+        impl From<$lib> for $name {
+            fn from(l: $lib) -> $name {
+                match l {
+                    $($lib::$lv => $name::$var),+
+                }
+            }
+        }
+    };
+}
+pub(crate) use arg_enum;
+
+arg_enum! {
+    /// How the height derivative is estimated ([`Filter`]).
+    pub enum FilterArg => Filter {
+        /// `[-1 0 1]/2`: sharpest 3-tap, no smoothing, most sensitive to noise.
+        Central => Central,
+        /// `[1 -8 0 8 -1]/12`: fourth-order accurate, no smoothing.
+        Central4 => Central4,
+        /// 3x3 Sobel: central difference smoothed by `[1 2 1]/4`.
+        Sobel => Sobel,
+        /// 3x3 Scharr: smoothing `[3 10 3]/16`, more rotation-invariant than Sobel.
+        Scharr => Scharr,
+        /// 3x3 Prewitt: smoothing `[1 1 1]/3`.
+        Prewitt => Prewitt,
+        /// 5x5 Sobel: `[-1 -2 0 2 1]/8` ⊗ `[1 4 6 4 1]/16`, smoothest.
+        Sobel5 => Sobel5,
+        /// FFT derivative: exact for band-limited periodic heights; costs an extra float plane.
+        Spectral => Spectral,
+    }
+}
+
+arg_enum! {
+    /// What lies beyond the image edge ([`Wrap`]).
+    pub enum WrapArg => Wrap {
+        /// The opposite edge: for tiling textures.
+        Repeat => Repeat,
+        /// The edge texel repeated: no slope invented beyond the edge. Right for standalone maps.
+        Clamp => Clamp,
+        /// Reflected, edge texel included (GL_MIRRORED_REPEAT).
+        Mirror => Mirror,
+    }
+}
+
+arg_enum! {
+    /// Which channel of the input carries the height ([`Channel`]).
+    pub enum ChannelArg => Channel {
+        /// Rec. 709 luma (0.2126 R + 0.7152 G + 0.0722 B) for colour, the gray value for gray.
+        Luma => Luma,
+        R => R,
+        G => G,
+        B => B,
+        A => A,
+    }
+}
+
+arg_enum! {
+    /// Which way `+Y` points in a map written ([`Convention`]).
+    pub enum ConventionArg => Convention {
+        /// `+Y` up (OpenGL, glTF, Blender): the project's convention.
+        Opengl => Opengl,
+        /// `+Y` down (DirectX, Unreal): `n.y` negated before encoding, nothing else.
+        Directx => Directx,
+    }
+}
 
 /// Mesh inputs and where their outputs go, shared by `tangents` and `bake`.
 #[derive(clap::Args, Debug)]

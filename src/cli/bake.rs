@@ -1,12 +1,23 @@
 //! `bumpbake bake MESH [--height H | --normal N] -o OUT`.
 
+use super::args::{ChannelArg, ConventionArg, FilterArg};
 use bumpbake::bake::maps::HeightSettings;
 use bumpbake::bake::{run as run_job, BakeJob, MapSource};
 use bumpbake::batch;
 use bumpbake::format::WriteOptions;
-use bumpbake::normalmap::{Channel, Convention, Filter};
+use bumpbake::normalmap::{Channel, Filter};
 use bumpbake::scene::ReadOptions;
 use bumpbake::transfer::{Match, Settings};
+
+super::args::arg_enum! {
+    /// How LOW parts find their HIGH parts ([`Match`]).
+    pub enum MatchArg => Match {
+        /// Pair parts whose names differ only by `_low`/`_high` (or `_lo`/`_hi`).
+        Auto => Auto,
+        /// Every LOW part sees every HIGH part.
+        None => None,
+    }
+}
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -55,8 +66,8 @@ pub struct Args {
     pub miss_mask: Option<PathBuf>,
     /// With --from: pair LOW and HIGH parts by name (`ring_low` bakes only from `ring_high`; also
     /// `_lo`/`_hi`, any case, before a `.001` number), or let every part see all of HIGH.
-    #[arg(long = "match", value_enum, default_value_t = Match::Auto, requires = "from")]
-    pub matching: Match,
+    #[arg(long = "match", value_enum, default_value_t = MatchArg::from(Match::default()), requires = "from")]
+    pub matching: MatchArg,
     /// With --from: the node to bake a LOW mesh through when several nodes show it.
     #[arg(long, requires = "from")]
     pub node: Option<String>,
@@ -82,11 +93,11 @@ pub struct Args {
     #[arg(long, requires = "height_range")]
     pub texel_size: Option<f32>,
     /// Derivative filter for height maps.
-    #[arg(long, value_enum, default_value_t = Filter::default())]
-    pub filter: Filter,
+    #[arg(long, value_enum, default_value_t = FilterArg::from(Filter::default()))]
+    pub filter: FilterArg,
     /// Height channel of colour images.
-    #[arg(long, value_enum, default_value_t = Channel::Luma)]
-    pub channel: Channel,
+    #[arg(long, value_enum, default_value_t = ChannelArg::from(Channel::default()))]
+    pub channel: ChannelArg,
     /// The height map holds depth.
     #[arg(long)]
     pub invert: bool,
@@ -95,7 +106,7 @@ pub struct Args {
     pub bits16: bool,
     /// Green-channel convention of --normal (default: detect it), or of --map-out.
     #[arg(long, value_enum)]
-    pub convention: Option<Convention>,
+    pub convention: Option<ConventionArg>,
     /// Keep everything, even what nothing uses.
     #[arg(long)]
     pub keep_all: bool,
@@ -132,13 +143,13 @@ pub fn run(a: Args) -> Result<u8> {
         material: a.material.clone(),
         height: HeightSettings {
             strength,
-            filter: a.filter,
+            filter: a.filter.into(),
             invert: a.invert,
-            channel: a.channel,
+            channel: a.channel.into(),
             sixteen_bit: a.bits16,
             ..Default::default()
         },
-        normal_convention: if transfer.is_some() { None } else { a.convention },
+        normal_convention: if transfer.is_some() { None } else { a.convention.map(Into::into) },
         keep_all: a.keep_all,
         bitangents: a.bitangents,
         read: ReadOptions {
@@ -178,14 +189,13 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         padding: a.padding,
         sixteen_bit: a.bits16,
         map_out: a.map_out.clone(),
-        convention: a.convention.unwrap_or_default(),
+        convention: a.convention.map(Into::into).unwrap_or_default(),
         height_out: a.height_out.clone(),
         miss_mask: a.miss_mask.clone(),
         read: ReadOptions { allow_outside: a.io.allow_outside, progress: progress.clone(), ..Default::default() },
-        matching: a.matching,
+        matching: a.matching.into(),
         node: a.node.clone(),
         progress,
-        ..Default::default()
     }))
 }
 

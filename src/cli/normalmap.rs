@@ -1,8 +1,9 @@
 //! `bumpbake normalmap HEIGHT -o NORMAL`: parses, checks the numbers, shows progress on a
 //! terminal, and hands the rest to `bumpbake::normalmap::convert_file`.
 
+use super::args::{ChannelArg, ConventionArg, FilterArg, WrapArg};
 use bumpbake::batch;
-use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, EncodeOptions, Filter, Options, Wrap};
+use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, Converted, EncodeOptions, Filter, Options, Wrap};
 use bumpbake::progress::Reporter;
 use bumpbake::{Error, Result};
 use clap::builder::TypedValueParser;
@@ -31,8 +32,8 @@ pub struct Args {
     #[arg(long, value_parser = ["png", "tif", "exr"], default_value = "png")]
     pub out_ext: String,
     /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
-    #[arg(long, value_enum, default_value_t = Channel::Luma)]
-    pub channel: Channel,
+    #[arg(long, value_enum, default_value_t = ChannelArg::from(Channel::default()))]
+    pub channel: ChannelArg,
     /// Strength S: how tall the whole black-to-white height range stands, in texels [default: 1].
     ///
     /// At 1, a slope from black to white across 100 texels tilts the normal by only 0.6°: right
@@ -48,14 +49,14 @@ pub struct Args {
     #[arg(long, value_name = "METRES", allow_negative_numbers = true, requires = "height_range")]
     pub texel_size: Option<f64>,
     /// Derivative filter (all estimate the true slope; see docs/normalmap.md).
-    #[arg(long, value_enum, default_value_t = Filter::default())]
-    pub filter: Filter,
+    #[arg(long, value_enum, default_value_t = FilterArg::from(Filter::default()))]
+    pub filter: FilterArg,
     /// What lies beyond the edges: repeat for tiling textures.
-    #[arg(long, value_enum, default_value_t = Wrap::Clamp)]
-    pub wrap: Wrap,
+    #[arg(long, value_enum, default_value_t = WrapArg::from(Wrap::default()))]
+    pub wrap: WrapArg,
     /// +Y up (opengl, glTF) or down (directx).
-    #[arg(long, value_enum, default_value_t = Convention::Opengl)]
-    pub convention: Convention,
+    #[arg(long, value_enum, default_value_t = ConventionArg::from(Convention::default()))]
+    pub convention: ConventionArg,
     /// Bits per PNG/TIFF sample: 8 or 16 (EXR is always float).
     #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["8", "16"]).map(|s| s.parse::<u8>().unwrap()))]
     pub bits: Option<u8>,
@@ -94,86 +95,35 @@ fn strength(args: &Args) -> Result<f32> {
     Ok(s)
 }
 
-/// What one conversion did.
-#[derive(serde::Serialize)]
-pub struct Converted {
-    pub input: PathBuf,
-    pub output: PathBuf,
-    pub timings_ms: bumpbake::timings::Timings,
-    /// A map that came out (nearly) flat.
-    pub warnings: Vec<String>,
-    /// Whether this is one of several inputs (the text then names the files).
-    #[serde(skip)]
-    pub batch: bool,
-}
-
 pub fn run(args: Args) -> Result<u8> {
     let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
-    let options = Options { strength: strength(&args)?, filter: args.filter, wrap: args.wrap, invert: args.invert };
+    let options =
+        Options { strength: strength(&args)?, filter: args.filter.into(), wrap: args.wrap.into(), invert: args.invert };
     let convert = |input: &Path, output: &Path| -> Result<Convert> {
         let format = nm::OutputFormat::from_path(output)?;
         Ok(Convert {
             input: input.to_path_buf(),
             output: output.to_path_buf(),
-            channel: args.channel,
+            channel: args.channel.into(),
             max_pixels: args.max_pixels,
             options,
             encode: EncodeOptions {
                 depth: format.depth(output, args.bits)?,
-                convention: args.convention,
+                convention: args.convention.into(),
                 alpha_height: args.alpha == Some(Alpha::Height),
             },
             png: nm::PngSettings::default(),
         })
     };
     let results = if args.heights.len() == 1 {
-        // One map: a bar over its rows, for big maps on a terminal.
-        let bar = progress(&args);
-        let tick = |rows: usize| bar.tick(rows as u64);
-        let r = convert(&args.heights[0], &outputs[0]).and_then(|c| nm::convert_file(&c, Some(&tick)));
-        bar.finish();
-        vec![r]
+        let progress = args.batch.single_progress(1);
+        vec![convert(&args.heights[0], &outputs[0]).and_then(|c| nm::convert_file(&c, &progress))]
     } else {
         let opts = args.batch.options(args.heights.len());
         batch::run(&args.heights, &opts, |input| {
-            convert(input, super::args::paired(&args.heights, &outputs, input)).and_then(|c| nm::convert_file(&c, None))
+            let c = convert(input, super::args::paired(&args.heights, &outputs, input))?;
+            nm::convert_file(&c, &Reporter::none()).map(|r| Converted { batch: true, ..r })
         })?
     };
-    let records: Vec<Result<Converted>> = results
-        .into_iter()
-        .zip(args.heights.iter().zip(&outputs))
-        .map(|(r, (i, o))| {
-            r.map(|(t, w)| Converted {
-                input: i.clone(),
-                output: o.clone(),
-                timings_ms: t,
-                warnings: w.into_iter().collect(),
-                batch: args.heights.len() > 1,
-            })
-        })
-        .collect();
-    super::print::all(&args.heights, records, args.batch.json, args.batch.quiet)
-}
-
-/// Rows done, told to a bar on a terminal for maps big enough to wait for; nothing when piped or
-/// under CI.
-fn progress(args: &Args) -> Reporter {
-    if !super::progress::wanted(args.batch.progress, args.batch.quiet) {
-        return Reporter::none();
-    }
-    // The header is read again by the conversion; this costs microseconds and keeps the
-    // library free of terminal concerns.
-    let rows = image::ImageReader::open(&args.heights[0])
-        .ok()
-        .and_then(|r| r.with_guessed_format().ok())
-        .and_then(|r| r.into_dimensions().ok())
-        .filter(|(w, h)| (*w as u64) * (*h as u64) >= 4 << 20 && (*w as u64) * (*h as u64) <= args.max_pixels);
-    match rows {
-        Some((_, h)) => {
-            let bar = super::progress::reporter(true);
-            bar.start(&format!("normalmap {}", args.heights[0].display()), h as u64, "rows");
-            bar
-        }
-        None => Reporter::none(),
-    }
+    super::print::all(&args.heights, results, args.batch.json, args.batch.quiet)
 }

@@ -54,7 +54,7 @@ pub struct Args {
     #[arg(long)]
     pub compare: Option<PathBuf>,
     /// What the difference image shows in compare mode.
-    #[arg(long, value_enum, default_value = "angle")]
+    #[arg(long, value_enum, default_value_t = DiffArg::from(DiffKind::default()))]
     pub diff: DiffArg,
     /// Ambient term (fraction of the base colour).
     #[arg(long, default_value_t = 0.06)]
@@ -102,10 +102,12 @@ impl clap::ValueEnum for ViewArg {
     }
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-pub enum DiffArg {
-    Angle,
-    Shaded,
+super::args::arg_enum! {
+    /// What the difference image shows ([`DiffKind`]).
+    pub enum DiffArg => DiffKind {
+        Angle => Angle,
+        Shaded => Shaded,
+    }
 }
 
 /// One picture rendered (`--json`: `docs/json.md`, preview).
@@ -212,11 +214,7 @@ pub fn run(a: Args) -> Result<u8> {
         }
         let r = read(reference, a.allow_outside)?;
         let c = read(cand, a.allow_outside)?;
-        let kind = match a.diff {
-            DiffArg::Angle => DiffKind::Angle,
-            DiffArg::Shaded => DiffKind::Shaded,
-        };
-        let (cmp, img) = compare(&r, &c, &opts, kind)?;
+        let (cmp, img) = compare(&r, &c, &opts, a.diff.into())?;
         write_atomic(&a.output, &img.to_png())?;
         let done = Compared {
             reference: reference.clone(),

@@ -1,8 +1,9 @@
 //! `bumpbake validate IN...`.
 
 use super::print::{github, junit, sarif, validate as report, Human};
+use bumpbake::normalmap::Convention;
 use bumpbake::scene::ReadOptions;
-use bumpbake::validate::{self, Code, Convention, Options};
+use bumpbake::validate::{self, Code, Options};
 use bumpbake::{Error, Result};
 use std::path::PathBuf;
 
@@ -34,7 +35,7 @@ pub struct Args {
     pub max_angle_deg: f64,
     /// Convention expected of normal-map images given directly (glTF materials expect opengl).
     #[arg(long, value_enum, default_value = "opengl")]
-    pub image_convention: Convention,
+    pub image_convention: ImageConvention,
     /// Let URIs reach outside the input's folder.
     #[arg(long)]
     pub allow_outside: bool,
@@ -47,6 +48,16 @@ pub struct Args {
     /// Files checked at once (default: one per core).
     #[arg(short, long, default_value_t = 0)]
     pub jobs: usize,
+}
+
+super::args::arg_enum! {
+    /// Which way a normal map's green channel is expected to run ([`Convention`]).
+    pub enum ImageConvention => Convention {
+        /// `+Y` up in the image: OpenGL, glTF, Blender.
+        Opengl => Opengl,
+        /// `-Y`: DirectX, Unreal, 3ds Max.
+        Directx => Directx,
+    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,7 +91,7 @@ pub fn run(a: Args) -> Result<u8> {
         strict: a.strict,
         deny: codes(&a.deny)?,
         allow: codes(&a.allow)?,
-        image_convention: a.image_convention,
+        image_convention: a.image_convention.into(),
         read: ReadOptions { allow_outside: a.allow_outside, ..Default::default() },
     };
     if let Some(c) = opts.deny.iter().find(|c| opts.allow.contains(c)) {

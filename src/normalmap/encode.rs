@@ -3,8 +3,9 @@
 //! texel by half a degree). Float output stores the same `n·0.5 + 0.5` unrounded, so every
 //! format decodes the same way: `n = 2·texel - 1`.
 
-use super::rows::{self, Progress};
+use super::rows;
 use super::{Convention, HeightPlane, NormalPlane, Options};
+use crate::progress::Reporter;
 
 /// Sample type of the encoded map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -122,7 +123,7 @@ fn channels(enc: &EncodeOptions) -> usize {
 
 /// Runs the filter and encodes in one pass, straight into the output buffer: the whole
 /// `normalmap` command's work between decoding and writing.
-pub fn encode_normals(height: &HeightPlane, opts: &Options, enc: &EncodeOptions, progress: Progress) -> NormalImage {
+pub fn encode_normals(height: &HeightPlane, opts: &Options, enc: &EncodeOptions, progress: &Reporter) -> NormalImage {
     let mut img = NormalImage { width: 0, height: 0, channels: 0, data: NormalData::U8(Vec::new()) };
     encode_normals_into(height, opts, enc, progress, &mut img);
     img
@@ -135,7 +136,7 @@ pub fn encode_normals_into(
     height: &HeightPlane,
     opts: &Options,
     enc: &EncodeOptions,
-    progress: Progress,
+    progress: &Reporter,
     img: &mut NormalImage,
 ) {
     let old = std::mem::replace(&mut img.data, NormalData::U8(Vec::new()));
@@ -165,7 +166,7 @@ fn fused_new<T: Copy + Send + Sync + Default>(
     height: &HeightPlane,
     opts: &Options,
     enc: &EncodeOptions,
-    progress: Progress,
+    progress: &Reporter,
     q: impl Fn(f32) -> T + Sync + Copy,
     qa: impl Fn(f32) -> T + Sync + Copy,
 ) -> Vec<T> {
@@ -181,7 +182,7 @@ fn fused<T: Copy + Send + Sync + Default>(
     height: &HeightPlane,
     opts: &Options,
     enc: &EncodeOptions,
-    progress: Progress,
+    progress: &Reporter,
     out: &mut Vec<T>,
     q: impl Fn(f32) -> T + Sync + Copy,
     qa: impl Fn(f32) -> T + Sync + Copy,
@@ -203,7 +204,7 @@ fn fused_rows<T: Copy + Send + Sync + Default>(
     enc: &EncodeOptions,
     y0: usize,
     n: usize,
-    progress: Progress,
+    progress: &Reporter,
     out: &mut Vec<T>,
     q: impl Fn(f32) -> T + Sync + Copy,
     qa: impl Fn(f32) -> T + Sync + Copy,
@@ -264,7 +265,7 @@ impl<'a> Strips<'a> {
         }
     }
     /// Encodes rows `y0..y0 + n` into `u8s` (8-bit) or `u16s` (16-bit).
-    pub fn encode(&mut self, y0: usize, n: usize, progress: Progress) {
+    pub fn encode(&mut self, y0: usize, n: usize, progress: &Reporter) {
         let (r, h, o, e) = (&self.rows, self.height, &self.opts, &self.enc);
         match e.depth {
             Depth::Bits8 => fused_rows(r, h, o, e, y0, n, progress, &mut self.u8s, quantize8, alpha8),
@@ -372,7 +373,7 @@ mod tests {
         for depth in [Depth::Bits8, Depth::Bits16, Depth::Float] {
             for convention in [Convention::Opengl, Convention::Directx] {
                 let enc = EncodeOptions { depth, convention, alpha_height: true };
-                let fused = encode_normals(&hp, &opts, &enc, None);
+                let fused = encode_normals(&hp, &opts, &enc, &Reporter::none());
                 let planed = encode_plane(&crate::normalmap::height_to_normal(&hp, &opts), &enc, Some(&hp));
                 assert_eq!(fused, planed);
             }

@@ -2,8 +2,9 @@
 //! allocated; outputs are written whole or not at all ([`crate::output::write_atomic`]).
 
 use super::{encode_normals, height_from_image, Channel, Depth, EncodeOptions, HeightPlane, NormalData, NormalImage};
-use super::{Convention, NormalPlane, Options, Progress};
+use super::{Convention, NormalPlane, Options};
 use crate::error::{Error, Result};
+use crate::progress::Reporter;
 use crate::timings::Timings;
 use image::{DynamicImage, ExtendedColorType, ImageEncoder};
 use std::io::Cursor;
@@ -311,33 +312,68 @@ pub struct Convert {
     pub png: PngSettings,
 }
 
-/// Runs [`Convert`]: decode, filter + encode, serialise, write. Returns the stage timings
-/// (`decode`, `filter`, `encode`, `write`, in ms). Nothing is written unless all succeeds.
+/// What one conversion did (`--json`: `docs/json.md`, normalmap).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Converted {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    /// `decode`, `filter`, `encode`, `write`, in ms.
+    pub timings_ms: Timings,
+    /// A map that came out (nearly) flat.
+    pub warnings: Vec<String>,
+    /// Whether this is one of several inputs (the text then names the files); the caller sets it.
+    #[serde(skip)]
+    pub batch: bool,
+}
+
+/// Runs [`Convert`]: decode, filter + encode, serialise, write. Nothing is written unless all
+/// succeeds. The filter's rows are a stage of `progress`, named after the input.
 ///
 /// PNG output is streamed: strips of rows are filtered (in parallel) into one reused buffer and
 /// handed to the compressor, so the encoded map never exists whole and memory stays at about
 /// the height plane plus the compressed file.
-pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<String>)> {
+pub fn convert_file(c: &Convert, progress: &Reporter) -> Result<Converted> {
     let format = OutputFormat::from_path(&c.output)?;
     let mut t = Timings::default();
     let height = t.time("decode", || load_height(&c.input, c.channel, c.max_pixels))?;
     // Judged on the texels as written, as `validate` judges them.
     let mut flat = super::Flatness::default();
-    let bytes = if format == OutputFormat::Png && c.encode.depth != Depth::Float {
-        let (bytes, filter_ms, encode_ms) = png_streamed(&height, &c.options, &c.encode, c.png, progress, &mut flat)
-            .map_err(|m| Error::output(&c.output, m))?;
-        t.stages.push(("filter".into(), filter_ms));
-        t.stages.push(("encode".into(), encode_ms));
-        bytes
-    } else {
-        let img = t.time("filter", || encode_normals(&height, &c.options, &c.encode, progress));
-        flat = super::Flatness::of_image(&img);
-        t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))?
-    };
+    progress.start(&format!("normalmap {}", c.input.display()), height.height as u64, "rows");
+    let bytes = filtered_bytes(c, format, &height, progress, &mut t, &mut flat);
+    progress.finish();
+    let bytes = bytes?;
     let warning = flat.warning(&height, c.options.strength, 1.0);
     drop(height);
     t.time("write", || crate::output::write_atomic(&c.output, &bytes))?;
-    Ok((t, warning))
+    Ok(Converted {
+        input: c.input.clone(),
+        output: c.output.clone(),
+        timings_ms: t,
+        warnings: warning.into_iter().collect(),
+        batch: false,
+    })
+}
+
+/// The encoded file's bytes: filtered and encoded, timed as `filter` and `encode`.
+fn filtered_bytes(
+    c: &Convert,
+    format: OutputFormat,
+    height: &HeightPlane,
+    progress: &Reporter,
+    t: &mut Timings,
+    flat: &mut super::Flatness,
+) -> Result<Vec<u8>> {
+    if format == OutputFormat::Png && c.encode.depth != Depth::Float {
+        let (bytes, filter_ms, encode_ms) = png_streamed(height, &c.options, &c.encode, c.png, progress, flat)
+            .map_err(|m| Error::output(&c.output, m))?;
+        t.stages.push(("filter".into(), filter_ms));
+        t.stages.push(("encode".into(), encode_ms));
+        Ok(bytes)
+    } else {
+        let img = t.time("filter", || encode_normals(height, &c.options, &c.encode, progress));
+        *flat = super::Flatness::of_image(&img);
+        t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))
+    }
 }
 
 /// Strip-by-strip filtering and PNG compression; returns the bytes and the time spent in
@@ -347,7 +383,7 @@ fn png_streamed(
     opts: &Options,
     enc: &EncodeOptions,
     settings: PngSettings,
-    progress: Progress,
+    progress: &Reporter,
     flat: &mut super::Flatness,
 ) -> std::result::Result<(Vec<u8>, f64, f64), String> {
     use std::io::Write;

@@ -33,17 +33,18 @@ pub use filter::wrap_index;
 pub use height::{height_from_image, Channel, HeightPlane};
 pub use io::{
     colour_words, convert_file, decode_normal_image, image_bytes, load_height, load_normal_image, open_image,
-    png_bytes, write_normal_image, Convert, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
+    png_bytes, write_normal_image, Convert, Converted, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
 pub use relief::{steepest_slope, Flatness, Verdict, EXACT_FLAT_DEG, NEARLY_FLAT_DEG};
-pub use rows::{unit_normal, Progress};
+pub use rows::unit_normal;
 
+use crate::progress::Reporter;
 use serde::Serialize;
 
 /// How the height derivative is estimated. Every filter is scaled to the true derivative per
 /// texel; they differ in how well they follow high frequencies, how much they smooth noise and
 /// what they cost (see `docs/normalmap.md` for the measured table).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Filter {
     /// `[-1 0 1]/2`: sharpest 3-tap, no smoothing, most sensitive to noise.
@@ -87,7 +88,7 @@ impl Filter {
 }
 
 /// What lies beyond the image edge.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Wrap {
     /// The opposite edge: for tiling textures.
@@ -100,7 +101,7 @@ pub enum Wrap {
 }
 
 /// Which way `+Y` points in the encoded map.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Convention {
     /// `+Y` up (OpenGL, glTF, Blender): the project's convention.
@@ -116,6 +117,14 @@ impl Convention {
         match self {
             Convention::Opengl => 1.0,
             Convention::Directx => -1.0,
+        }
+    }
+
+    /// The words reports use for this convention.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Convention::Opengl => "OpenGL (+Y)",
+            Convention::Directx => "DirectX (-Y)",
         }
     }
 }
@@ -168,7 +177,7 @@ impl NormalPlane {
 }
 
 /// Float unit normals for every texel of `height` (OpenGL convention).
-pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: Progress) -> NormalPlane {
+pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: &Reporter) -> NormalPlane {
     let (w, h) = (height.width, height.height);
     let mut data = vec![[0.0f32; 3]; w * h];
     let s = opts.signed_strength();
@@ -190,5 +199,5 @@ pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: Progr
 
 /// The name other commands use: [`normals_from_height`] without progress.
 pub fn height_to_normal(height: &HeightPlane, opts: &Options) -> NormalPlane {
-    normals_from_height(height, opts, None)
+    normals_from_height(height, opts, &Reporter::none())
 }

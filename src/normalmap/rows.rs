@@ -7,10 +7,8 @@
 use super::filter::{self, Kernel, RowScratch};
 use super::spectral::{Spectral, SpectralScratch};
 use super::{Filter, HeightPlane, Options};
+use crate::progress::Reporter;
 use rayon::prelude::*;
-
-/// Called with the number of rows just finished; from several threads at once.
-pub type Progress<'a> = Option<&'a (dyn Fn(usize) + Sync)>;
 
 /// `normalize(-S·gx, -S·gy, 1)`, finite and unit for any finite input and any strength: the
 /// scaled slopes are clamped at 1e15, far beyond any representable tilt (the angle from the
@@ -88,7 +86,7 @@ pub(crate) fn for_each_row<T: Send, S>(
     opts: &Options,
     out: &mut [T],
     stride: usize,
-    progress: Progress,
+    progress: &Reporter,
     state: impl Fn() -> S + Sync,
     sink: impl Fn(usize, usize, &[f32], &[f32], &mut [T], &mut S) + Sync,
 ) {
@@ -117,7 +115,7 @@ impl<'a> Rows<'a> {
         y0: usize,
         out: &mut [T],
         stride: usize,
-        progress: Progress,
+        progress: &Reporter,
         state: impl Fn() -> S + Sync,
         sink: impl Fn(usize, usize, &[f32], &[f32], &mut [T], &mut S) + Sync,
     ) {
@@ -159,9 +157,7 @@ impl<'a> Rows<'a> {
                     sink(y, x0, &gx[..n], &gy[..n], out, &mut st);
                 }
             }
-            if let Some(p) = progress {
-                p(chunk.len() / stride);
-            }
+            progress.tick((chunk.len() / stride) as u64);
         });
     }
 }

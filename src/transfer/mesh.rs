@@ -286,20 +286,21 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
     Ok(out)
 }
 
-/// Reads every HIGH file in world space (`given`, when there is one, stands for the first);
+/// Reads every HIGH file in world space (the meshes `given` stand for the first files);
 /// returns the triangles, each file's triangle count and the named parts (consecutive runs with
 /// one name).
 pub fn high(
     paths: &[std::path::PathBuf],
     read: &ReadOptions,
     origin: DVec3,
-    mut given: Option<RawMesh>,
+    given: Vec<RawMesh>,
 ) -> Result<(High, Vec<usize>, Vec<HighPart>)> {
     let mut h = High::default();
     let mut counts = Vec::new();
     let mut parts: Vec<HighPart> = Vec::new();
+    let mut given = given.into_iter();
     for (f, path) in paths.iter().enumerate() {
-        let raw = match given.take() {
+        let raw = match given.next() {
             Some(m) => m,
             None => read_raw(path, read)?,
         };

@@ -64,13 +64,7 @@ pub struct Settings {
     pub matching: Match,
     /// The node to bake a LOW mesh shown by several nodes through.
     pub node: Option<String>,
-    /// HIGH already in memory, standing for the first of `highs` and taken by the first bake:
-    /// how the bench bakes meshes too large to write and read at every run.
-    pub given: Option<GivenHigh>,
 }
-
-/// A mesh handed to one bake.
-pub type GivenHigh = std::sync::Arc<std::sync::Mutex<Option<RawMesh>>>;
 
 impl Default for Settings {
     fn default() -> Self {
@@ -92,7 +86,6 @@ impl Default for Settings {
             progress: Reporter::none(),
             matching: Match::Auto,
             node: None,
-            given: None,
         }
     }
 }
@@ -173,6 +166,13 @@ fn build_sets(
 /// Bakes HIGH into LOW: one map per material in `materials`, over the triangle primitives that
 /// use it (which must carry tangents already). HIGH is read and its trees built once.
 pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
+    bake_from(scene, materials, s, Vec::new())
+}
+
+/// [`bake`] with HIGH meshes already in memory, as [`read_raw`](crate::format::raw) hands them
+/// over: they stand for the first of `s.highs` (whose names then only label the report), and
+/// the rest are read.
+pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<RawMesh>) -> Result<Baked> {
     check(s)?;
     let mut t = Timings::default();
     let per_mat: Vec<Vec<PrimRef>> = materials.iter().map(|&m| material_prims(scene, m)).collect();
@@ -183,8 +183,7 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
     }
     let (low_names, low_part) = mesh::low_parts(&placed);
     let (origin, diagonal) = mesh::frame(scene, &placed)?;
-    let given = s.given.as_ref().and_then(|g| g.lock().ok().and_then(|mut m| m.take()));
-    let (high, counts, high_parts) = t.time("read high", || mesh::high(&s.highs, &s.read, origin, given))?;
+    let (high, counts, high_parts) = t.time("read high", || mesh::high(&s.highs, &s.read, origin, high))?;
     crate::timings::mem_mark("transfer read");
     let high_names: Vec<String> = high_parts.iter().map(|p| p.name.clone()).collect();
     let groups = parts::group(&low_names, &high_names, s.matching);

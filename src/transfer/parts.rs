@@ -9,7 +9,7 @@
 //! every HIGH part no group took.
 
 /// How LOW parts find their HIGH parts.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum Match {
     /// Pair parts whose names differ only by `_low`/`_high` (or `_lo`/`_hi`).
     #[default]

@@ -22,8 +22,9 @@ pub mod lossy;
 pub mod normal_image;
 mod scene_checks;
 
+pub use crate::normalmap::Convention;
 pub use codes::{Code, Severity};
-pub use normal_image::{detect_convention, Convention};
+pub use normal_image::{describe_convention, detect_convention, REPORT_CONFIDENCE};
 
 use crate::error::{Error, Result};
 use crate::scene::{ReadOptions, Scene};
@@ -55,7 +56,7 @@ impl Default for Options {
             strict: false,
             deny: Vec::new(),
             allow: Vec::new(),
-            image_convention: Convention::OpenGl,
+            image_convention: Convention::Opengl,
             read: ReadOptions::default(),
         }
     }

@@ -18,38 +18,28 @@
 use super::lossy;
 pub use super::lossy::Codec;
 use super::{Code, Example, Finding, Subject, Worst};
-use crate::normalmap::{Flatness, Verdict};
+use crate::normalmap::{Convention, Flatness, Verdict};
 use image::{DynamicImage, Rgb32FImage, RgbImage};
 
-/// Which way a normal map's green channel runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Convention {
-    /// `+Y` up in the image: OpenGL, glTF, Blender.
-    #[value(name = "opengl")]
-    OpenGl,
-    /// `-Y`: DirectX, Unreal, 3ds Max.
-    #[value(name = "directx")]
-    DirectX,
-    /// The map does not say (flat, separable relief, not from a height field).
-    #[value(skip)]
-    Unknown,
+/// Words for a detected convention, "undetermined" when the map does not say.
+pub fn describe_convention(c: Option<Convention>) -> &'static str {
+    c.map_or("undetermined", Convention::describe)
 }
 
-impl Convention {
-    pub fn describe(self) -> &'static str {
-        match self {
-            Convention::OpenGl => "OpenGL (+Y)",
-            Convention::DirectX => "DirectX (-Y)",
-            Convention::Unknown => "undetermined",
-        }
+/// `None` (the map does not say: flat, separable relief, not from a height field) as `"unknown"`.
+fn convention_or_unknown<S: serde::Serializer>(c: &Option<Convention>, s: S) -> Result<S::Ok, S::Error> {
+    match c {
+        Some(c) => serde::Serialize::serialize(c, s),
+        None => s.serialize_str("unknown"),
     }
 }
 
 /// The detector's full answer.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Detection {
-    pub convention: Convention,
+    /// `None` when the map does not say.
+    #[serde(serialize_with = "convention_or_unknown")]
+    pub convention: Option<Convention>,
     /// 0 (no evidence) to 1 (certain).
     pub confidence: f64,
     /// Mean squared curl of the map as it is.
@@ -101,7 +91,7 @@ impl Texels<'_> {
 }
 
 /// Which convention an 8-bit normal map follows, and how sure the detector is (0..1).
-pub fn detect_convention(img: &RgbImage) -> (Convention, f64) {
+pub fn detect_convention(img: &RgbImage) -> (Option<Convention>, f64) {
     let d = detect(&Texels::Rgb8(img));
     (d.convention, d.confidence)
 }
@@ -130,10 +120,10 @@ pub fn detect(t: &Texels) -> Detection {
     let total = e_as + e_flip;
     let (convention, confidence) =
         if samples == 0 || total.is_nan() || total <= 1e-12 * samples as f64 || !total.is_finite() {
-            (Convention::Unknown, 0.0)
+            (None, 0.0)
         } else {
             let conf = (e_flip - e_as).abs() / total;
-            (if e_as <= e_flip { Convention::OpenGl } else { Convention::DirectX }, conf)
+            (Some(if e_as <= e_flip { Convention::Opengl } else { Convention::Directx }), conf)
         };
     let per = |e: f64| if samples > 0 { e / samples as f64 } else { 0.0 };
     Detection { convention, confidence, curl_as_is: per(e_as), curl_flipped: per(e_flip), samples }
@@ -331,16 +321,14 @@ fn codec_noise(
 }
 
 fn green_finding(d: &Detection, expected: Convention, wanted_by: &str) -> Option<Finding> {
-    if expected == Convention::Unknown
-        || d.convention == Convention::Unknown
-        || d.convention == expected
-        || d.confidence < REPORT_CONFIDENCE
-    {
+    if d.convention.is_none_or(|c| c == expected) || d.confidence < REPORT_CONFIDENCE {
         return None;
     }
     let hint = match expected {
-        Convention::OpenGl => Code::NORMALMAP_GREEN_FLIPPED.hint().to_string(),
-        _ => "invert the green channel: this map is OpenGL (+Y up) and DirectX (-Y) is expected".to_string(),
+        Convention::Opengl => Code::NORMALMAP_GREEN_FLIPPED.hint().to_string(),
+        Convention::Directx => {
+            "invert the green channel: this map is OpenGL (+Y up) and DirectX (-Y) is expected".to_string()
+        }
     };
     Some(
         Finding::new(
@@ -350,7 +338,7 @@ fn green_finding(d: &Detection, expected: Convention, wanted_by: &str) -> Option
             "texels",
             format!(
                 "looks like {} (confidence {:.2}); {wanted_by} expects {}",
-                d.convention.describe(),
+                describe_convention(d.convention),
                 d.confidence,
                 expected.describe()
             ),
@@ -380,21 +368,21 @@ mod tests {
     #[test]
     fn float_texels_of_a_saddle() {
         let gl = detect(&Texels::RgbF(&saddle(false)));
-        assert_eq!(gl.convention, Convention::OpenGl);
+        assert_eq!(gl.convention, Some(Convention::Opengl));
         assert!(gl.confidence > 0.99, "{gl:?}");
         let dx = detect(&Texels::RgbF(&saddle(true)));
-        assert_eq!(dx.convention, Convention::DirectX);
+        assert_eq!(dx.convention, Some(Convention::Directx));
         assert!(dx.confidence > 0.99, "{dx:?}");
     }
 
     #[test]
     fn flat_tiny_and_vertical_maps_are_unknown() {
         let flat = RgbImage::from_pixel(8, 8, image::Rgb([128, 128, 255]));
-        assert_eq!(detect_convention(&flat), (Convention::Unknown, 0.0));
+        assert_eq!(detect_convention(&flat), (None, 0.0));
         let tiny = RgbImage::from_pixel(2, 2, image::Rgb([200, 10, 255]));
-        assert_eq!(detect_convention(&tiny), (Convention::Unknown, 0.0));
+        assert_eq!(detect_convention(&tiny), (None, 0.0));
         // z <= 0 everywhere: no slopes to measure.
         let down = RgbImage::from_pixel(8, 8, image::Rgb([128, 128, 0]));
-        assert_eq!(detect_convention(&down), (Convention::Unknown, 0.0));
+        assert_eq!(detect_convention(&down), (None, 0.0));
     }
 }

@@ -290,7 +290,7 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
             }
             let codec = bytes.as_deref().map(normal_image::Codec::sniff).unwrap_or(normal_image::Codec::Lossless);
             match bytes.and_then(|b| image::decode(&b)) {
-                Ok(img) => normal_image::check(&img, codec, Convention::OpenGl, &wanted_by, &mut s),
+                Ok(img) => normal_image::check(&img, codec, Convention::Opengl, &wanted_by, &mut s),
                 Err(e) => s.check(
                     Code::NORMALMAP_UNREADABLE,
                     Some(Finding::new(

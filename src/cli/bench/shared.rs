@@ -23,3 +23,27 @@ pub(super) fn print<T: serde::Serialize>(r: &T, json: bool, text: impl FnOnce(&T
     }
     Ok(())
 }
+
+/// FNV-1a 64 of `bytes` as hex: tells two runs' outputs apart in a report (not a checksum).
+pub(super) fn fingerprint(bytes: &[u8]) -> String {
+    let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+    format!("{h:016x}")
+}
+
+/// The smallest and largest of `v` ((inf, 0) when empty: times are never negative).
+pub(super) fn spread(v: &[f64]) -> (f64, f64) {
+    (v.iter().copied().fold(f64::INFINITY, f64::min), v.iter().copied().fold(0.0, f64::max))
+}
+
+/// The median of `v` (sorted in place), the mean of the middle two for an even count; 0 when empty.
+pub(super) fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}

@@ -1,7 +1,14 @@
 //! `bumpbake bench transfer`: `bake --from` on an analytic surface, error against run time.
 
-use bumpbake::bench::transfer_large::{Plan, Source};
+mod blender;
+mod large;
+mod row;
+
+use bumpbake::analytic::torus::Torus;
 use bumpbake::{Error, Result};
+use large::{Plan, Source};
+use row::{time_one, Row};
+use std::path::Path;
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
@@ -84,7 +91,7 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
     if !(1..=8192).contains(&a.large_size) {
         return Err(Error::usage("--large-size: 1 to 8192 texels"));
     }
-    let blender = a.blender.clone().map(|python| bumpbake::bench::blender::Blender { python });
+    let blender = a.blender.clone().map(|python| blender::Blender { python });
     let plan = Plan {
         millions,
         sources,
@@ -98,9 +105,9 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
     let quiet = a.json;
     let body = |exe: &std::path::Path, dir: &std::path::Path| {
         let mut r = if a.runs == 0 || a.read_only {
-            bumpbake::bench::transfer::Report::empty()
+            Report::empty()
         } else {
-            bumpbake::bench::transfer::run(exe, dir, &quality, a.runs, a.keep.is_some(), |row| {
+            measure(exe, dir, &quality, a.runs, a.keep.is_some(), |row| {
                 if !quiet {
                     eprintln!(
                         "  {} triangles, {}², {} sample(s): {:.3} s, {:.3}° mean",
@@ -113,7 +120,7 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
                 }
             })?
         };
-        r.large = bumpbake::bench::transfer_large::run(exe, dir, &plan, |row| {
+        r.large = large::run(exe, dir, &plan, |row| {
             if !quiet {
                 eprintln!(
                     "  {} triangles from {:?}, {}²: {:.2} s, peak {:.0} MB ({:.0} B/triangle), {:.3}° mean",
@@ -137,6 +144,125 @@ pub fn run(a: BenchTransferArgs) -> Result<u8> {
         }
         None => super::shared::with_scratch("transfer", body)?,
     };
-    super::shared::print(&r, a.json, bumpbake::bench::transfer::table)?;
+    super::shared::print(&r, a.json, table)?;
     Ok(0)
+}
+
+/// Writes the bench's HIGH (`n_th x n_ph` quads) and the 48 x 24 LOW into `dir`.
+pub fn write_case(
+    dir: &Path,
+    torus: &Torus,
+    n_th: usize,
+    n_ph: usize,
+) -> Result<(std::path::PathBuf, std::path::PathBuf)> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, e))?;
+    let high = dir.join(format!("high_{}.glb", 2 * n_th * n_ph));
+    let low = dir.join("low.glb");
+    std::fs::write(&high, torus.high(n_th, n_ph).glb()).map_err(|e| Error::output(&high, e))?;
+    std::fs::write(&low, torus.low(48, 24).glb()).map_err(|e| Error::output(&low, e))?;
+    Ok((high, low))
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Report {
+    pub torus: String,
+    pub low_triangles: usize,
+    pub threads: usize,
+    /// Error and time for map sizes and sample counts (HIGH at its largest but one).
+    pub quality: Vec<Row>,
+    /// Time against HIGH's triangle count (1024², one sample).
+    pub scaling: Vec<Row>,
+    /// Production-scale HIGH (millions of triangles) from memory and from files.
+    pub large: Vec<large::LargeRow>,
+}
+
+/// The HIGH tessellations of the scaling series: quads around the ring and around the tube.
+pub const HIGHS: [(usize, usize); 4] = [(274, 68), (548, 137), (1096, 274), (1550, 387)];
+
+impl Report {
+    /// A report with no rows yet.
+    pub fn empty() -> Report {
+        let t = Torus::default();
+        Report {
+            torus: describe(&t),
+            low_triangles: 2 * 48 * 24,
+            threads: rayon::current_num_threads(),
+            quality: Vec::new(),
+            scaling: Vec::new(),
+            large: Vec::new(),
+        }
+    }
+}
+
+fn describe(t: &Torus) -> String {
+    format!("R {} r {} displaced by {}·(sin 8θ sin 4φ + ½ cos(3θ+6φ)); LOW 48x24 quads", t.major, t.minor, t.amp)
+}
+
+/// The whole bench: `quality` lists `(size, samples)` pairs run on the 600k-triangle HIGH; `keep`
+/// leaves the cases in `dir`.
+fn measure(
+    exe: &Path,
+    dir: &Path,
+    quality: &[(usize, usize)],
+    runs: usize,
+    keep: bool,
+    mut progress: impl FnMut(&Row),
+) -> Result<Report> {
+    let torus = Torus::default();
+    let mut scaling = Vec::new();
+    let mut rows = Vec::new();
+    for (k, &(a, b)) in HIGHS.iter().enumerate() {
+        let (high, low) = write_case(dir, &torus, a, b)?;
+        let tris = 2 * a * b;
+        if k == 2 {
+            for &(size, samples) in quality {
+                let r = time_one(exe, dir, &low, &high, tris, size, samples, runs, &torus, None)?;
+                progress(&r);
+                rows.push(r);
+            }
+        }
+        let r = time_one(exe, dir, &low, &high, tris, 1024, 1, runs, &torus, None)?;
+        progress(&r);
+        scaling.push(r);
+        if !keep {
+            let _ = std::fs::remove_file(&high);
+        }
+    }
+    Ok(Report {
+        torus: describe(&torus),
+        low_triangles: 2 * 48 * 24,
+        threads: rayon::current_num_threads(),
+        quality: rows,
+        scaling,
+        large: Vec::new(),
+    })
+}
+
+/// The report as a text table.
+pub fn table(r: &Report) -> String {
+    let mut s = format!("{}; {} threads\n", r.torus, r.threads);
+    s += "HIGH tris   size  samples  median s  (min-max)      read ms  bvh ms  rays ms  peak MB  mean°  p99°   mean° if normalised\n";
+    for row in r.quality.iter().chain(&r.scaling) {
+        s += &format!(
+            "{:>9} {:>6} {:>8} {:>9.3}  ({:.3}-{:.3}) {:>8.0} {:>7.0} {:>8.0} {:>8.0} {:>6.3} {:>6.3} {:>6.3}\n",
+            row.high_triangles,
+            row.size,
+            row.samples * row.samples,
+            row.median_s,
+            row.min_s,
+            row.max_s,
+            row.read_high_ms,
+            row.bvh_ms,
+            row.rays_ms,
+            row.peak_mb,
+            row.error.synced.mean,
+            row.error.synced.p99,
+            row.error.normalised_frame.mean
+        );
+    }
+    if !r.large.is_empty() {
+        s += "\n";
+        s += &large::table(&r.large);
+    }
+    s
 }

@@ -51,7 +51,7 @@ impl Record for bumpbake::bake::BakeReport {
     const SCHEMA: &'static str = "bumpbake-bake/1";
 }
 
-impl Record for crate::cli::normalmap::Converted {
+impl Record for bumpbake::normalmap::Converted {
     const SCHEMA: &'static str = "bumpbake-normalmap/1";
 }
 

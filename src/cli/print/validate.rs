@@ -41,7 +41,7 @@ fn text(r: &Report) -> String {
             }
             if let Some(d) = &sub.convention {
                 let verdict = if d.confidence >= normal_image::REPORT_CONFIDENCE {
-                    format!("looks {}", d.convention.describe())
+                    format!("looks {}", normal_image::describe_convention(d.convention))
                 } else {
                     "undetermined".into()
                 };

@@ -3,9 +3,10 @@
 //! binary PLY files the bench writes, onto the same LOW at 2048²: stage times, peak memory and
 //! bytes per HIGH triangle.
 
-use super::transfer::{evaluate, time_one, Evaluation, Torus};
-use crate::error::{Error, Result};
-use crate::format::raw::RawMesh;
+use super::row::time_one;
+use bumpbake::analytic::torus::{evaluate, Evaluation, Torus};
+use bumpbake::error::{Error, Result};
+use bumpbake::format::raw::RawMesh;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::TAU;
@@ -91,30 +92,28 @@ pub fn tessellation(millions: f64) -> (usize, usize) {
     (2 * n_ph, n_ph)
 }
 
-impl Torus {
-    /// HIGH as [`Torus::high`] makes it, straight into the baker's form, built in parallel.
-    pub fn high_raw(&self, n_th: usize, n_ph: usize) -> RawMesh {
-        let vn: Vec<([f32; 3], [f32; 3])> = (0..n_th * n_ph)
-            .into_par_iter()
-            .map(|k| {
-                let (i, j) = (k % n_th, k / n_th);
-                let (p, n) = self.point_normal(TAU * i as f64 / n_th as f64, TAU * j as f64 / n_ph as f64);
-                (p.as_vec3().to_array(), n.as_vec3().to_array())
-            })
-            .collect();
-        let (positions, normals) = vn.into_iter().unzip();
-        let triangles: Vec<[u32; 3]> = (0..n_th * n_ph)
-            .into_par_iter()
-            .flat_map_iter(|k| {
-                let (i, j) = (k % n_th, k / n_th);
-                let v = |i: usize, j: usize| ((j % n_ph) * n_th + (i % n_th)) as u32;
-                let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
-                [[a, b, c], [a, c, d]]
-            })
-            .collect();
-        let parts = vec![crate::format::raw::Part { name: "torus".into(), material: None, start: 0 }];
-        RawMesh { positions, normals, normal_triangles: triangles.clone(), triangles, parts, ..Default::default() }
-    }
+/// HIGH as [`Torus::high`] makes it, straight into the baker's form, built in parallel.
+fn high_raw(torus: &Torus, n_th: usize, n_ph: usize) -> RawMesh {
+    let vn: Vec<([f32; 3], [f32; 3])> = (0..n_th * n_ph)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k % n_th, k / n_th);
+            let (p, n) = torus.point_normal(TAU * i as f64 / n_th as f64, TAU * j as f64 / n_ph as f64);
+            (p.as_vec3().to_array(), n.as_vec3().to_array())
+        })
+        .collect();
+    let (positions, normals) = vn.into_iter().unzip();
+    let triangles: Vec<[u32; 3]> = (0..n_th * n_ph)
+        .into_par_iter()
+        .flat_map_iter(|k| {
+            let (i, j) = (k % n_th, k / n_th);
+            let v = |i: usize, j: usize| ((j % n_ph) * n_th + (i % n_th)) as u32;
+            let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+            [[a, b, c], [a, c, d]]
+        })
+        .collect();
+    let parts = vec![bumpbake::format::raw::Part { name: "torus".into(), material: None, start: 0 }];
+    RawMesh { positions, normals, normal_triangles: triangles.clone(), triangles, parts, ..Default::default() }
 }
 
 /// Writes `m` as OBJ (`v`, `vn`, `f a//a b//b c//c`), formatted in parallel blocks.
@@ -217,17 +216,15 @@ fn bake_in_memory(
     out: &Path,
     mesh: RawMesh,
     size: usize,
-) -> Result<(crate::bake::BakeReport, f64, f64, u64)> {
-    use crate::transfer::Settings;
-    let given = std::sync::Arc::new(std::sync::Mutex::new(Some(mesh)));
-    let job = crate::bake::BakeJob {
+) -> Result<(bumpbake::bake::BakeReport, f64, f64, u64)> {
+    use bumpbake::transfer::Settings;
+    let job = bumpbake::bake::BakeJob {
         mesh: low.to_path_buf(),
         output: out.to_path_buf(),
-        map: crate::bake::MapSource::Transfer(Box::new(Settings {
+        map: bumpbake::bake::MapSource::Transfer(Box::new(Settings {
             highs: vec![PathBuf::from("(generated)")],
             width: size,
             height: size,
-            given: Some(given),
             ..Default::default()
         })),
         ..Default::default()
@@ -235,7 +232,7 @@ fn bake_in_memory(
     // The generated mesh is HIGH as a reader would hand it over: it counts in the peak.
     reset_peak();
     let (t, cpu) = (std::time::Instant::now(), cpu_seconds(false));
-    let r = crate::bake::run(&job)?;
+    let r = bumpbake::bake::run_from(&job, vec![mesh])?;
     Ok((r, t.elapsed().as_secs_f64(), cpu_seconds(false) - cpu, peak_bytes()))
 }
 
@@ -245,20 +242,20 @@ pub fn time_reader(path: &Path, runs: usize) -> Result<ReadTiming> {
     let mut cpus = Vec::new();
     for _ in 0..runs.max(1) {
         let (t, cpu) = (std::time::Instant::now(), cpu_seconds(false));
-        let m = crate::format::raw::read_raw(path, &crate::scene::ReadOptions::default())?;
+        let m = bumpbake::format::raw::read_raw(path, &bumpbake::scene::ReadOptions::default())?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
         cpus.push((cpu_seconds(false) - cpu) * 1e3);
         drop(m);
     }
     let mb = std::fs::metadata(path).map_or(0.0, |m| m.len() as f64 / 1e6);
-    let min_ms = super::spread(&times).0;
-    let median_ms = super::median(&mut times);
+    let min_ms = super::super::shared::spread(&times).0;
+    let median_ms = super::super::shared::median(&mut times);
     Ok(ReadTiming {
         runs: times.len(),
         median_ms,
         min_ms,
         mb_s: mb / median_ms * 1e3,
-        cpu_ms: super::median(&mut cpus),
+        cpu_ms: super::super::shared::median(&mut cpus),
     })
 }
 
@@ -305,11 +302,11 @@ pub fn large_row(
             return Ok(row);
         }
         let out = dir.join(format!("out_mem_{tris}.glb"));
-        let (r, wall, cpu, peak) = bake_in_memory(low, &out, torus.high_raw(n_th, n_ph), plan.size)?;
+        let (r, wall, cpu, peak) = bake_in_memory(low, &out, high_raw(&torus, n_th, n_ph), plan.size)?;
         let tr = r.transfer.ok_or_else(|| Error::usage("bench transfer: the bake made no transfer report"))?;
         let stage = |n: &str| tr.timings_ms.stages.iter().find(|s| s.0 == n).map_or(f64::NAN, |s| s.1);
         row.error = evaluate(&out, &truth, &|_| true)?;
-        row.out_fingerprint = std::fs::read(&out).map(|b| super::fingerprint(&b)).unwrap_or_default();
+        row.out_fingerprint = std::fs::read(&out).map(|b| super::super::shared::fingerprint(&b)).unwrap_or_default();
         let _ = std::fs::remove_file(&out);
         (row.wall_s, row.cpu_s) = (wall, cpu);
         (row.read_high_ms, row.bvh_ms, row.rays_ms) = (stage("read high"), stage("bvh"), stage("rays"));
@@ -319,7 +316,7 @@ pub fn large_row(
     let path = dir.join(format!("high_{tris}.{}", if source == Source::Obj { "obj" } else { "ply" }));
     // A kept file is reused: the writer is deterministic, and a 50M-triangle OBJ takes a while.
     if !(plan.keep && path.exists()) {
-        let mesh = torus.high_raw(n_th, n_ph);
+        let mesh = high_raw(&torus, n_th, n_ph);
         match source {
             Source::Obj => write_obj(&mesh, &path)?,
             _ => write_ply(&mesh, &path)?,

@@ -1,6 +1,6 @@
 //! SVG plots of a tangent benchmark: error against run time, and run time against mesh size.
 
-use super::tangents::{Report, Row, Surface};
+use super::{Report, Row, Surface};
 
 /// A log-log plot area: the SVG header, title, decade grid lines, frame and axis labels, and the
 /// mapping from data to pixels.

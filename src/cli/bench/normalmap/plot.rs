@@ -1,7 +1,7 @@
 //! A hand-written SVG scatter plot: error against time, both on log axes. Small enough that a
 //! plotting crate would cost more to build than this costs to read.
 
-use super::normalmap::Report;
+use super::Report;
 use std::fmt::Write;
 
 const COLOURS: [&str; 8] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf", "#7f7f7f"];

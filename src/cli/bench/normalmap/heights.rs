@@ -3,7 +3,7 @@
 //! Every field is periodic over the `n x n` image (integer wave vectors; the Gaussian is ~1e-50
 //! at the border), so the benchmark runs with `repeat` and measures the filter, not the edges.
 
-use crate::normalmap::HeightPlane;
+use bumpbake::normalmap::HeightPlane;
 use std::f64::consts::TAU;
 
 /// `amp · sin(2π(p·x + q·y_up)/n + phase)`.

@@ -4,7 +4,7 @@
 //! normal map at one sample per texel, with cage extrusion and ray distance set to the bench's
 //! reach; it reports its own stage times and peak resident memory.
 
-use crate::error::{Error, Result};
+use bumpbake::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
 const SCRIPT: &str = include_str!("blender_bake.py");
@@ -92,16 +92,16 @@ impl Blender {
 impl Runs {
     /// The row, its ratio taken against bumpbake's median `ours_s`.
     pub fn row(mut self, ours_s: f64) -> BlenderRow {
-        let (min_s, max_s) = super::spread(&self.wall);
-        let median_s = super::median(&mut self.wall);
+        let (min_s, max_s) = super::super::shared::spread(&self.wall);
+        let median_s = super::super::shared::median(&mut self.wall);
         BlenderRow {
             version: self.version,
             runs: self.wall.len(),
             median_s,
             min_s,
             max_s,
-            import_high_s: super::median(&mut self.import_high),
-            bake_s: super::median(&mut self.bake),
+            import_high_s: super::super::shared::median(&mut self.import_high),
+            bake_s: super::super::shared::median(&mut self.bake),
             peak_mb: self.peak_mb,
             ratio: median_s / ours_s,
         }

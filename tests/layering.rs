@@ -1,0 +1,327 @@
+//! The library is free of the command line, and its modules form layers (docs/architecture.md,
+//! "Module map"): these tests read the sources and fail on a clap type or a printout in the
+//! library, an import from a higher layer, or a circle of file imports.
+//!
+//! Code under `#[cfg(test)]` is left out: a test may reach anything it checks against.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+fn src() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src")
+}
+
+/// Every `.rs` file under `src/`, as paths relative to it (`scene/view.rs`).
+fn files() -> Vec<String> {
+    fn walk(dir: &Path, root: &Path, out: &mut Vec<String>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(&p, root, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(&src(), &src(), &mut out);
+    out.sort();
+    out
+}
+
+/// The file's code: its tests cut off and comments dropped.
+fn code(file: &str) -> String {
+    let text = std::fs::read_to_string(src().join(file)).unwrap();
+    let text = text.split("#[cfg(test)]").next().unwrap();
+    text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n")
+}
+
+fn in_binary(file: &str) -> bool {
+    file == "main.rs" || file.starts_with("cli/")
+}
+
+#[test]
+fn clap_is_only_in_the_command_line() {
+    let offenders: Vec<String> = files()
+        .into_iter()
+        .filter(|f| !in_binary(f))
+        .filter(|f| code(f).split(|c: char| !c.is_alphanumeric() && c != '_').any(|w| w == "clap"))
+        .collect();
+    assert!(offenders.is_empty(), "clap outside src/cli and src/main.rs: {offenders:?}");
+}
+
+/// What the library returns is printed by `cli/print` and `cli/bench`, never by the library.
+#[test]
+fn the_library_prints_no_text_tables_or_plots() {
+    // BUMPBAKE_MEMTRACE=1 lines on stderr: a diagnostic for profiling, which `bench` reads back.
+    const EXCEPTIONS: [&str; 1] = ["timings.rs"];
+    let words = ["println!", "print!", "eprintln!", "eprint!", "stdout()", "stderr()", "<svg"];
+    let offenders: Vec<(String, &str)> = files()
+        .into_iter()
+        .filter(|f| !in_binary(f) && !EXCEPTIONS.contains(&f.as_str()))
+        .flat_map(|f| {
+            let c = code(&f);
+            words.iter().filter(|w| c.contains(*w)).map(|w| (f.clone(), *w)).collect::<Vec<_>>()
+        })
+        .collect();
+    assert!(offenders.is_empty(), "printing in the library: {offenders:?}");
+}
+
+/// The layer of a top-level module of the library (the first part of its path).
+fn layer(module: &str) -> Option<u8> {
+    Some(match module {
+        "error" | "progress" | "output" | "timings" | "batch" => 0,
+        "scene" => 1,
+        "format" => 2,
+        "tangent" | "normalmap" => 3,
+        "bake" | "transfer" | "validate" | "preview" | "inspect" | "analytic" => 4,
+        // `crate::{Error, Result}`: the crate root's re-exports of `error`.
+        "Error" | "Result" => 0,
+        _ => return None,
+    })
+}
+
+/// Every path a file names after `prefix::` (`crate`, `super`, `bumpbake`), brace groups
+/// expanded: `use crate::{scene::Scene, Error}` gives `scene::Scene` and `Error`.
+fn paths_after(code: &str, prefix: &str) -> Vec<Vec<String>> {
+    fn expand(s: &str, base: &[String], out: &mut Vec<Vec<String>>) {
+        // `s` starts right after `::`.
+        if let Some(inner) = s.strip_prefix('{') {
+            let mut depth = 0;
+            let mut start = 0;
+            for (i, c) in inner.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        expand(inner[start..i].trim(), base, out);
+                        return;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        expand(inner[start..i].trim(), base, out);
+                        start = i + 1;
+                    }
+                    _ => {}
+                }
+            }
+            return;
+        }
+        let mut segs = base.to_vec();
+        let mut rest = s;
+        loop {
+            let end = rest.find(|c: char| !c.is_alphanumeric() && c != '_').unwrap_or(rest.len());
+            if end == 0 {
+                break;
+            }
+            segs.push(rest[..end].to_string());
+            rest = &rest[end..];
+            match rest.strip_prefix("::") {
+                Some(r) if r.starts_with('{') => return expand(r, &segs, out),
+                Some(r) => rest = r,
+                None => break,
+            }
+        }
+        if segs.len() > base.len() && segs.last().is_some_and(|s| s != "self") {
+            out.push(segs);
+        } else if segs.len() > base.len() {
+            segs.pop();
+            out.push(segs);
+        }
+    }
+    let mut out = Vec::new();
+    let pat = format!("{prefix}::");
+    for (i, _) in code.match_indices(&pat) {
+        let before = code[..i].chars().next_back();
+        if before.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':') {
+            continue;
+        }
+        expand(&code[i + pat.len()..], &[], &mut out);
+    }
+    out
+}
+
+/// No file of the library names a module of a higher layer.
+#[test]
+fn imports_flow_downward() {
+    // `scene::view` turns quantized values into floats through `format::dequant`, the one place
+    // that decodes them (docs/architecture.md): the model reaching down into a format helper.
+    const EXCEPTIONS: [(&str, &str); 1] = [("scene/view.rs", "format")];
+    let mut offenders = Vec::new();
+    for f in files().into_iter().filter(|f| !in_binary(f) && f.contains('/') || f == "inspect.rs") {
+        let own = f.split(['/', '.']).next().unwrap();
+        let own_layer = layer(own).unwrap_or_else(|| panic!("{f}: module {own} has no layer in this test"));
+        for p in paths_after(&code(&f), "crate") {
+            let to = p[0].as_str();
+            if to == own || EXCEPTIONS.contains(&(f.as_str(), to)) {
+                continue;
+            }
+            match layer(to) {
+                Some(l) if l > own_layer => offenders.push(format!("{f} -> crate::{}", p.join("::"))),
+                Some(_) => {}
+                None => offenders.push(format!("{f} -> crate::{}: a module with no layer in this test", p.join("::"))),
+            }
+        }
+    }
+    assert!(offenders.is_empty(), "imports from a higher layer: {offenders:#?}");
+}
+
+/// The file a module path names: the longest prefix of `segs` that is a file under `root`.
+fn file_of(root: &str, segs: &[String]) -> Option<String> {
+    let all = files();
+    for n in (0..=segs.len()).rev() {
+        let base = if root.is_empty() {
+            segs[..n].join("/")
+        } else {
+            std::iter::once(root.to_string()).chain(segs[..n].iter().cloned()).collect::<Vec<_>>().join("/")
+        };
+        let candidates = if base.is_empty() {
+            vec!["lib.rs".to_string()]
+        } else {
+            vec![format!("{base}.rs"), format!("{base}/mod.rs")]
+        };
+        if let Some(c) = candidates.into_iter().find(|c| all.contains(c)) {
+            return Some(c);
+        }
+    }
+    None
+}
+
+/// A file's module path inside its crate (`cli/bench/tangents/plot.rs`: cli, bench, tangents,
+/// plot; `scene/mod.rs`: scene).
+fn module_of(file: &str) -> Vec<String> {
+    let p = file.trim_end_matches(".rs");
+    let p = p.strip_suffix("/mod").unwrap_or(p);
+    if p == "lib" || p == "main" {
+        return Vec::new();
+    }
+    p.split('/').map(String::from).collect()
+}
+
+/// The files each file imports from, by `crate::`, `super::` and (in the binary) `bumpbake::`.
+fn import_graph() -> BTreeMap<String, BTreeSet<String>> {
+    let mut g = BTreeMap::new();
+    for f in files() {
+        let c = code(&f);
+        let here = module_of(&f);
+        let mut to = BTreeSet::new();
+        // The binary's crate root is main.rs, whose only module is `cli`.
+        for p in paths_after(&c, "crate") {
+            to.extend(file_of("", &p));
+        }
+        if in_binary(&f) {
+            for p in paths_after(&c, "bumpbake") {
+                to.extend(file_of("", &p));
+            }
+        }
+        for p in paths_after(&c, "super") {
+            let mut base: Vec<String> = here[..here.len().saturating_sub(1)].to_vec();
+            let mut rest = &p[..];
+            while rest.first().is_some_and(|s| s == "super") {
+                base.pop();
+                rest = &rest[1..];
+            }
+            base.extend(rest.iter().cloned());
+            to.extend(file_of("", &base));
+        }
+        to.remove(&f);
+        to.remove("lib.rs");
+        to.remove("main.rs");
+        g.insert(f, to);
+    }
+    g
+}
+
+/// Whether `a` is the parent module of `b` or the other way round.
+fn parent_and_child(a: &str, b: &str) -> bool {
+    let (ma, mb) = (module_of(a), module_of(b));
+    let is_parent = |p: &[String], c: &[String]| c.len() == p.len() + 1 && c.starts_with(p);
+    is_parent(&ma, &mb) || is_parent(&mb, &ma)
+}
+
+/// Circles between sibling files that split one reader or structure and still share helpers both
+/// ways. Each lies inside one folder and one layer; they are named so that a new circle fails.
+const KNOWN_CIRCLES: [&[&str]; 5] = [
+    &["scene/material.rs", "scene/texcoord.rs"],
+    &["format/image.rs", "format/ktx2/mod.rs"],
+    &["format/obj_block.rs", "format/obj_fast.rs", "format/obj_parse.rs"],
+    &["format/ply.rs", "format/ply_ascii.rs", "format/ply_binary.rs"],
+    &["transfer/bvh.rs", "transfer/wide.rs"],
+];
+
+#[test]
+fn no_import_circle_but_parent_and_child() {
+    let g = import_graph();
+    // Tarjan's strongly connected components, iteratively simple enough for a few hundred files.
+    let names: Vec<&String> = g.keys().collect();
+    let idx: BTreeMap<&String, usize> = names.iter().enumerate().map(|(i, n)| (*n, i)).collect();
+    let adj: Vec<Vec<usize>> =
+        names.iter().map(|n| g[*n].iter().filter_map(|t| idx.get(t).copied()).collect()).collect();
+    let n = names.len();
+    let (mut index, mut low, mut on, mut stack, mut next) =
+        (vec![usize::MAX; n], vec![0; n], vec![false; n], vec![], 0);
+    let mut sccs: Vec<Vec<usize>> = Vec::new();
+    fn strong(
+        v: usize,
+        adj: &[Vec<usize>],
+        st: (&mut Vec<usize>, &mut Vec<usize>, &mut Vec<bool>, &mut Vec<usize>, &mut usize),
+        sccs: &mut Vec<Vec<usize>>,
+    ) {
+        let (index, low, on, stack, next) = st;
+        index[v] = *next;
+        low[v] = *next;
+        *next += 1;
+        stack.push(v);
+        on[v] = true;
+        for &w in &adj[v] {
+            if index[w] == usize::MAX {
+                strong(w, adj, (index, low, on, stack, next), sccs);
+                low[v] = low[v].min(low[w]);
+            } else if on[w] {
+                low[v] = low[v].min(index[w]);
+            }
+        }
+        if low[v] == index[v] {
+            let mut c = Vec::new();
+            while let Some(w) = stack.pop() {
+                on[w] = false;
+                c.push(w);
+                if w == v {
+                    break;
+                }
+            }
+            sccs.push(c);
+        }
+    }
+    for v in 0..n {
+        if index[v] == usize::MAX {
+            strong(v, &adj, (&mut index, &mut low, &mut on, &mut stack, &mut next), &mut sccs);
+        }
+    }
+    let circles: Vec<Vec<&String>> = sccs
+        .into_iter()
+        .filter(|c| c.len() > 1)
+        .map(|c| c.into_iter().map(|i| names[i]).collect::<Vec<_>>())
+        .filter(|c| !(c.len() == 2 && parent_and_child(c[0], c[1])))
+        .filter(|c| {
+            let mut files: Vec<&str> = c.iter().map(|f| f.as_str()).collect();
+            files.sort();
+            !KNOWN_CIRCLES.contains(&files.as_slice())
+        })
+        .collect();
+    assert!(circles.is_empty(), "files that import from each other: {circles:#?}");
+}
+
+/// The checks themselves see what they look for.
+#[test]
+fn the_rules_see_their_targets() {
+    let p = paths_after("use crate::{scene::{Scene, view::Geometry}, Error};\nlet x = super::super::a::b();", "crate");
+    assert_eq!(p, vec![vec!["scene", "Scene"], vec!["scene", "view", "Geometry"], vec!["Error"]]);
+    let s = paths_after("super::super::a::b()", "super");
+    assert_eq!(s, vec![vec!["super", "a", "b"]]);
+    assert_eq!(file_of("", &["scene".into(), "view".into(), "Geometry".into()]).as_deref(), Some("scene/view.rs"));
+    assert!(parent_and_child("cli/bench/tangents.rs", "cli/bench/tangents/plot.rs"));
+    assert!(!parent_and_child("cli/bench/tangents.rs", "cli/bench/normalmap.rs"));
+    let g = import_graph();
+    assert!(g["cli/bench/tangents/plot.rs"].contains("cli/bench/tangents.rs"), "{:?}", g["cli/bench/tangents/plot.rs"]);
+    assert!(g["bake/maps.rs"].contains("validate/mod.rs"), "{:?}", g["bake/maps.rs"]);
+}
