@@ -119,6 +119,11 @@ pub struct Stack(Vec<Todo>);
 /// The tree is four-wide: a node's four children are slab-tested at once, one lane each, and
 /// visited nearest first. A child is dropped only once its part of the ray lies farther from the
 /// origin than the best hit; which hit wins never depends on the order: see `Hit::better_than`.
+///
+/// Known limits (`tests/nearest.rs`): the slab test has no rounding margin, so a hit on a box's
+/// boundary can be skipped by an ulp (a tie may then go to a higher index, or a ray through a
+/// box's corner miss it); and a ray with no part along an axis, lying in a box's lower face in
+/// that axis, misses the box (`0 * inf` is NaN there and the lane's bounds come out `+inf`).
 pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -> Option<Hit> {
     if bvh.is_empty() {
         return None;
