@@ -79,3 +79,6 @@ impl WideNode {
         self.lanes |= 1 << lane;
     }
 }
+
+// The sizes the comments above and the memory figures count on.
+const _: () = assert!(std::mem::size_of::<Node>() == 32 && std::mem::size_of::<WideNode>() == 128);
