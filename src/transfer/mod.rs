@@ -16,7 +16,6 @@ pub mod parts;
 pub mod raster;
 pub mod raycast;
 pub mod report;
-pub mod wide;
 
 use crate::error::{Error, Result};
 use crate::format::raw::RawMesh;

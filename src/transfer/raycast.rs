@@ -116,9 +116,14 @@ pub struct Stack(Vec<Todo>);
 
 /// The hit nearest the ray's origin with `t` in `[-back, front]`.
 ///
-/// A node's four slab tests are those of the binary tree, lane by lane, in the same arithmetic
-/// (and with the same NaN rule: `_mm_min_ps`/`_mm_max_ps` keep the second operand); children are
-/// visited nearest first. Which hit wins never depends on the order: see `Hit::better_than`.
+/// The tree is four-wide: a node's four children are slab-tested at once, one lane each, and
+/// visited nearest first. A child is dropped only once its part of the ray lies farther from the
+/// origin than the best hit; which hit wins never depends on the order: see `Hit::better_than`.
+///
+/// Known limits (`tests/nearest.rs`): the slab test has no rounding margin, so a hit on a box's
+/// boundary can be skipped by an ulp (a tie may then go to a higher index, or a ray through a
+/// box's corner miss it); and a ray with no part along an axis, lying in a box's lower face in
+/// that axis, misses the box (`0 * inf` is NaN there and the lane's bounds come out `+inf`).
 pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -> Option<Hit> {
     if bvh.is_empty() {
         return None;
@@ -147,7 +152,7 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -
     }
 }
 
-/// Tests a leaf's triangles, or a node's four boxes: the children hit are pushed, farthest
+/// Tests a leaf's triangles, or a four-wide node's boxes: the children hit are pushed, farthest
 /// first, except the nearest, which is returned to be visited next.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -180,6 +185,9 @@ fn visit(
         return None;
     }
     let n = &bvh.nodes[todo.child as usize];
+    // The operand order of these `min`s and `max`s is part of the result: `_mm_min_ps` and
+    // `_mm_max_ps` return their second operand when either is NaN (`0 * inf`, a ray parallel to
+    // a slab starting on its face).
     let slab = |a: usize| {
         let t0 = (n.min[a] - o[a]) * inv[a];
         let t1 = (n.max[a] - o[a]) * inv[a];
@@ -196,8 +204,8 @@ fn visit(
     // `-far` when behind, else 0 (branch-free: the lanes in `mask` have `near <= far`).
     let gaps = near.max(-far).max(Vec4::ZERO).to_array();
     let kid = |lane: usize| Todo { child: n.child[lane], count: n.count[lane] as u32, gap: gaps[lane] };
-    // The nearest child is visited next (ties: the lower lane, as the binary tree's left child
-    // was); the others are pushed farthest first.
+    // The nearest child is visited next (ties: the lower lane); the others are pushed farthest
+    // first, so they pop nearest first.
     let first = mask.trailing_zeros() as usize;
     mask &= mask - 1;
     let mut next = kid(first);

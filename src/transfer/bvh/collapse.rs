@@ -1,67 +1,37 @@
-//! The tree as the rays walk it: four children to a node, their boxes side by side, so one
-//! node's four slab tests are four-lane vector operations and a ray fetches about half as many
-//! nodes as in the binary tree it is collapsed from.
+//! The binary tree collapsed to four-wide nodes, as the rays walk it: a ray fetches about half
+//! as many nodes as in the binary tree, and tests a node's four boxes at once.
 
-use super::bvh::Node;
-use glam::Vec4;
+use super::node::{Node, WideNode};
 use rayon::prelude::*;
 
-/// One node: 128 bytes, two cache lines.
-#[derive(Debug, Clone, Copy)]
-#[repr(C, align(64))]
-pub struct Wide {
-    /// The children's boxes by axis: `min[0]` holds the four children's smallest x.
-    pub min: [Vec4; 3],
-    pub max: [Vec4; 3],
-    /// Per child: an inner child's node index, or a leaf's first triangle (in leaf order).
-    pub child: [u32; 4],
-    /// Per child: 0 for an inner node, else the leaf's triangle count.
-    pub count: [u8; 4],
-    /// Bit `k` set when child `k` exists.
-    pub lanes: u32,
-}
-
-impl Wide {
-    fn empty() -> Wide {
-        Wide { min: [Vec4::ZERO; 3], max: [Vec4::ZERO; 3], child: [0; 4], count: [0; 4], lanes: 0 }
-    }
-
-    fn set(&mut self, k: usize, n: &Node) {
-        for a in 0..3 {
-            self.min[a][k] = n.min[a];
-            self.max[a][k] = n.max[a];
-        }
-        self.lanes |= 1 << k;
-    }
-}
-
-/// Collapses the binary tree `bin` (root at 0, left child next, as [`super::bvh`] builds it)
+/// Collapses the binary tree `bin` (root at 0, each inner node's first child right after it)
 /// into four-wide nodes, root at 0, each node before its children (depth first).
-fn collapse(bin: &[Node]) -> Vec<Wide> {
-    if bin[0].n > 0 {
+fn collapse_binary(bin: &[Node]) -> Vec<WideNode> {
+    if bin[0].is_leaf() {
         return lone_leaf(&bin[0]);
     }
     let mut out = Vec::with_capacity(bin.len() / 3 + 1);
-    node(bin, 0, &mut out);
+    collapse_inner(bin, 0, &mut out);
     out
 }
 
 /// A tree that is one leaf: a root with that leaf as its only child.
-fn lone_leaf(leaf: &Node) -> Vec<Wide> {
-    let mut w = Wide::empty();
-    w.set(0, leaf);
-    w.child[0] = leaf.a;
+fn lone_leaf(leaf: &Node) -> Vec<WideNode> {
+    let mut w = WideNode::empty();
+    w.set_box(0, leaf);
+    w.child[0] = leaf.right_or_first;
     w.count[0] = leaf_count(leaf);
     vec![w]
 }
 
 fn leaf_count(n: &Node) -> u8 {
-    u8::try_from(n.n).expect("leaves hold at most 255 triangles")
+    u8::try_from(n.count).expect("leaves hold at most 255 triangles")
 }
 
 /// The children a wide node takes from a binary node whose children are `l` and `r`: the
 /// largest (by area) inner child opened into its own two children, in place, until four (or
 /// only leaves) remain. `inner` gives an inner child's area and children, `None` for a leaf.
+/// Opening the largest first keeps the children the rays are likeliest to enter in one node.
 fn open<T: Copy>(l: T, r: T, inner: impl Fn(T) -> Option<(f32, T, T)>) -> ([T; 4], usize) {
     let mut kids = [l, r, r, r];
     let mut len = 2;
@@ -87,19 +57,19 @@ fn open<T: Copy>(l: T, r: T, inner: impl Fn(T) -> Option<(f32, T, T)>) -> ([T; 4
 
 /// The wide node for binary inner node `b`: its two children opened, then the largest inner
 /// child among them opened until four (or only leaves) remain; returns its index.
-fn node(bin: &[Node], b: usize, out: &mut Vec<Wide>) -> u32 {
-    let inner = |k: usize| (bin[k].n == 0).then(|| (bin[k].area(), k + 1, bin[k].a as usize));
-    let (kids, len) = open(b + 1, bin[b].a as usize, inner);
+fn collapse_inner(bin: &[Node], b: usize, out: &mut Vec<WideNode>) -> u32 {
+    let inner = |k: usize| (!bin[k].is_leaf()).then(|| (bin[k].area(), k + 1, bin[k].right_or_first as usize));
+    let (kids, len) = open(b + 1, bin[b].right_or_first as usize, inner);
     let me = out.len();
-    out.push(Wide::empty());
-    let mut w = Wide::empty();
+    out.push(WideNode::empty());
+    let mut w = WideNode::empty();
     for (lane, &k) in kids[..len].iter().enumerate() {
-        w.set(lane, &bin[k]);
-        if bin[k].n > 0 {
-            w.child[lane] = bin[k].a;
+        w.set_box(lane, &bin[k]);
+        if bin[k].is_leaf() {
+            w.child[lane] = bin[k].right_or_first;
             w.count[lane] = leaf_count(&bin[k]);
         } else {
-            w.child[lane] = node(bin, k, out);
+            w.child[lane] = collapse_inner(bin, k, out);
         }
     }
     out[me] = w;
@@ -109,17 +79,17 @@ fn node(bin: &[Node], b: usize, out: &mut Vec<Wide>) -> u32 {
 /// The tree as the Morton build leaves it: binary splits over ranges, each range collapsed to
 /// its own four-wide tree on the core that built it, while its nodes are still in cache. A
 /// split carries its box in a [`Node`].
-pub enum Upper {
+pub(super) enum Upper {
     /// A range's binary root (its box, or the leaf it is) and its four-wide tree (empty when
     /// the root is a leaf).
-    Range(Node, Vec<Wide>),
+    Range(Node, Vec<WideNode>),
     Split(Node, Box<Upper>, Box<Upper>),
 }
 
 impl Upper {
     /// A range over the binary tree `bin` (root at 0).
     pub fn range(bin: Vec<Node>) -> Upper {
-        let wide = if bin[0].n > 0 { Vec::new() } else { collapse(&bin) };
+        let wide = if bin[0].is_leaf() { Vec::new() } else { collapse_binary(&bin) };
         Upper::Range(bin[0], wide)
     }
 
@@ -133,14 +103,14 @@ impl Upper {
     /// The four-wide tree, root at 0: the splits collapsed as a binary tree is (a range's
     /// root is not opened into the node above it), then every range's tree appended in the
     /// order the splits meet them, its inner children shifted as it is copied.
-    pub fn collapse(self) -> Vec<Wide> {
+    pub fn collapse(self) -> Vec<WideNode> {
         match self {
-            Upper::Range(root, _) if root.n > 0 => return lone_leaf(&root),
+            Upper::Range(root, _) if root.is_leaf() => return lone_leaf(&root),
             Upper::Range(_, wide) => return wide,
             Upper::Split(..) => {}
         }
         let (mut out, mut later) = (Vec::new(), Vec::new());
-        split_node(&self, &mut out, &mut later);
+        collapse_split(&self, &mut out, &mut later);
         // Each range's tree goes after the upper nodes, in the order the splits met them; the
         // copies (tens of MB at 10M triangles, every page of them new) run on every core.
         let base = out.len();
@@ -157,8 +127,10 @@ impl Upper {
             let r = starts.partition_point(|&s| s <= i) - 1;
             let mut n = later[r].2[i - starts[r]];
             let at = (base + starts[r]) as u32;
-            for k in (0..4).filter(|&k| n.lanes & (1 << k) != 0 && n.count[k] == 0) {
-                n.child[k] += at;
+            for k in 0..4 {
+                if n.has(k) && !n.is_leaf(k) {
+                    n.child[k] += at;
+                }
             }
             n
         }));
@@ -166,25 +138,25 @@ impl Upper {
     }
 }
 
-/// The wide node for split `s`, as [`node`] builds one; lanes whose child is a range's root
-/// (not a leaf) are listed in `later` as (node, lane, the range's tree) to be pointed at it
-/// once placed.
-fn split_node<'a>(s: &'a Upper, out: &mut Vec<Wide>, later: &mut Vec<(usize, usize, &'a [Wide])>) -> u32 {
-    let Upper::Split(_, l, r) = s else { unreachable!("split_node is given splits") };
+/// The wide node for split `s`, as [`collapse_inner`] builds one; lanes whose child is a
+/// range's root (not a leaf) are listed in `later` as (node, lane, the range's tree) to be
+/// pointed at it once placed.
+fn collapse_split<'a>(s: &'a Upper, out: &mut Vec<WideNode>, later: &mut Vec<(usize, usize, &'a [WideNode])>) -> u32 {
+    let Upper::Split(_, l, r) = s else { unreachable!("collapse_split is given splits") };
     let inner = |k: &'a Upper| match k {
         Upper::Split(n, a, b) => Some((n.area(), &**a, &**b)),
         Upper::Range(..) => None,
     };
     let (kids, len) = open(&**l, &**r, inner);
     let me = out.len();
-    out.push(Wide::empty());
-    let mut w = Wide::empty();
+    out.push(WideNode::empty());
+    let mut w = WideNode::empty();
     for (lane, k) in kids[..len].iter().enumerate() {
-        w.set(lane, k.node());
+        w.set_box(lane, k.node());
         match k {
-            Upper::Split(..) => w.child[lane] = split_node(k, out, later),
-            Upper::Range(root, _) if root.n > 0 => {
-                w.child[lane] = root.a;
+            Upper::Split(..) => w.child[lane] = collapse_split(k, out, later),
+            Upper::Range(root, _) if root.is_leaf() => {
+                w.child[lane] = root.right_or_first;
                 w.count[lane] = leaf_count(root);
             }
             Upper::Range(_, wide) => later.push((me, lane, wide)),

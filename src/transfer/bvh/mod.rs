@@ -1,0 +1,218 @@
+//! A bounding-volume hierarchy over HIGH's triangles, four children to a node.
+//!
+//! Built in two steps: a binary tree by the surface area heuristic (`sah.rs`), its upper levels
+//! split at Morton-code boundaries on a large HIGH (`morton.rs`), then collapsed to the four-wide
+//! nodes the rays walk (`collapse.rs`; both node layouts in `node.rs`).
+//!
+//! The tree depends on the triangles only, never on the thread count: every split is decided by
+//! the same binned sweep, and subtrees built on other threads are spliced in a fixed order.
+//! The tree holds its triangles' corners and corner indices (into normals that several trees can
+//! share) permuted into leaf order, so that a leaf's triangles sit together; HIGH's positions
+//! are needed only while it is built.
+
+mod bounds;
+mod collapse;
+mod morton;
+mod node;
+mod sah;
+
+use bounds::{bounds_of, Aabb, Item};
+use collapse::Upper;
+use glam::Vec3A;
+pub use node::WideNode;
+
+/// Ranges smaller than this are built, bounded and binned on the current thread.
+const PARALLEL_MIN: usize = 16 * 1024;
+
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    /// The four-wide nodes, root at 0, each before its children.
+    pub nodes: Vec<WideNode>,
+    /// Each leaf-order triangle's index in the input.
+    pub ids: Vec<u32>,
+    /// The triangles in leaf order: a leaf's triangles are read from one place, not through
+    /// their indices from positions scattered over the whole mesh.
+    tris: Vec<Tri>,
+}
+
+/// A triangle as the rays read it: its corners, and beside them (in the cache line the test
+/// has just loaded) the corner indices its hit is shaded with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Tri {
+    corners: [[f32; 3]; 3],
+    /// Into the positions the tree was built from, or as [`Bvh::build_indexed`] was told.
+    index: [u32; 3],
+}
+
+impl Bvh {
+    /// Builds the tree over `triangles` (corner indices into `positions`, which must be in
+    /// range). Every triangle is kept, degenerate ones too: the intersection test rejects them,
+    /// and their ids stay aligned with the input.
+    pub fn build(positions: &[[f32; 3]], triangles: Vec<[u32; 3]>) -> Bvh {
+        Bvh::build_indexed(positions, triangles, |_| None)
+    }
+
+    /// [`Bvh::build`], with each triangle's shading corners given by `index(id)` where it
+    /// gives some (a mesh whose normals have indices of their own, as an OBJ's `vn`), else its
+    /// position indices: they are read in leaf order, beside the corners.
+    pub fn build_indexed(
+        positions: &[[f32; 3]],
+        triangles: Vec<[u32; 3]>,
+        index: impl Fn(u32) -> Option<[u32; 3]> + Sync,
+    ) -> Bvh {
+        use rayon::prelude::*;
+        let n = triangles.len();
+        if n == 0 {
+            return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
+        }
+        let mut items: Vec<Item> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let mut b = Aabb::EMPTY;
+                triangles[i].iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
+                Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
+            })
+            .collect();
+        let bc = bounds_of(&items);
+        let upper = if morton::applies(n) {
+            morton::build(&mut items, &bc.1)
+        } else {
+            Upper::range(sah::build_par(&mut items, 0, bc))
+        };
+        // Each array is dropped as soon as the next is made from it: the build's peak is what
+        // bounds memory on a large HIGH.
+        let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
+        drop(items);
+        let nodes = upper.collapse();
+        let tris = ids
+            .par_iter()
+            .map(|&i| {
+                let t = triangles[i as usize];
+                Tri { corners: t.map(|k| positions[k as usize]), index: index(i).unwrap_or(t) }
+            })
+            .collect();
+        Bvh { nodes, ids, tris }
+    }
+
+    /// An empty tree has no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
+    /// The corners of leaf-order triangle `k`.
+    #[inline]
+    pub fn corners(&self, k: usize) -> &[[f32; 3]; 3] {
+        &self.tris[k].corners
+    }
+
+    /// The corner indices of leaf-order triangle `k` (see [`Bvh::build_indexed`]).
+    #[inline]
+    pub fn index(&self, k: usize) -> [u32; 3] {
+        self.tris[k].index
+    }
+
+    /// Bytes held, for the memory figures.
+    pub fn bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<WideNode>()
+            + self.tris.capacity() * std::mem::size_of::<Tri>()
+            + self.ids.capacity() * 4
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A tree over unshared corners, as a triangle soup, and its positions.
+    pub(crate) fn soup(tris: &[[Vec3A; 3]]) -> (Bvh, Vec<[f32; 3]>) {
+        let positions: Vec<[f32; 3]> = tris.iter().flat_map(|t| t.map(|p| p.to_array())).collect();
+        let k = tris.len() as u32;
+        (Bvh::build(&positions, (0..k).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect()), positions)
+    }
+
+    fn grid_tris(n: usize) -> Vec<[Vec3A; 3]> {
+        let mut t = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let p = |a: usize, b: usize| Vec3A::new(a as f32, b as f32, ((a * 7 + b * 3) % 5) as f32 * 0.1);
+                t.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                t.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+            }
+        }
+        t
+    }
+
+    /// Every triangle is in exactly one leaf, and every node's box holds its children's: built
+    /// by binned SAH alone, and with Morton-split upper levels.
+    #[test]
+    fn leaves_cover_every_triangle_once_and_boxes_nest() {
+        for side in [150, 200] {
+            let tris = grid_tris(side);
+            assert_eq!(tris.len() >= morton::MORTON_MIN, side == 200);
+            covered_once_and_nested(&tris);
+        }
+    }
+
+    fn covered_once_and_nested(tris: &[[Vec3A; 3]]) {
+        let (bvh, _) = soup(tris);
+        let mut seen = vec![0u32; tris.len()];
+        // The box of what node `i`'s lanes hold, each checked against the lane's own box.
+        fn walk(b: &Bvh, i: usize, seen: &mut [u32]) -> Aabb {
+            let n = b.nodes[i];
+            let mut all = Aabb::EMPTY;
+            for lane in (0..4).filter(|&k| n.has(k)) {
+                let lo = Vec3A::new(n.min[0][lane], n.min[1][lane], n.min[2][lane]);
+                let hi = Vec3A::new(n.max[0][lane], n.max[1][lane], n.max[2][lane]);
+                let held = if n.is_leaf(lane) {
+                    let mut a = Aabb::EMPTY;
+                    let first = n.child[lane] as usize;
+                    for k in first..first + n.count[lane] as usize {
+                        seen[b.ids[k] as usize] += 1;
+                        b.corners(k).iter().for_each(|&p| a.grow(p.into()));
+                    }
+                    a
+                } else {
+                    walk(b, n.child[lane] as usize, seen)
+                };
+                assert!(
+                    lo.cmple(held.min).all() && hi.cmpge(held.max).all(),
+                    "node {i} lane {lane} does not hold its child"
+                );
+                all.join(&held);
+            }
+            all
+        }
+        walk(&bvh, 0, &mut seen);
+        assert!(seen.iter().all(|&s| s == 1));
+        // Four-wide: far fewer nodes than triangles.
+        assert!(bvh.nodes.len() * 4 < tris.len(), "{} nodes", bvh.nodes.len());
+    }
+
+    /// The same tree, node for node, whatever the thread count (large enough for the parallel
+    /// binning and the parallel subtrees).
+    #[test]
+    fn same_tree_on_any_thread_count() {
+        let tris = grid_tris(260);
+        let build = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+            let (b, _) = pool.install(|| soup(&tris));
+            let bits = |v: [glam::Vec4; 3]| v.map(|a| a.to_array().map(f32::to_bits));
+            let nodes: Vec<_> = b.nodes.iter().map(|n| (bits(n.min), bits(n.max), n.child, n.count, n.lanes)).collect();
+            (nodes, b.tris, b.ids)
+        };
+        assert!(tris.len() > PARALLEL_MIN * 8);
+        let one = build(1);
+        assert_eq!(one, build(2));
+        assert_eq!(one, build(3));
+    }
+
+    /// Identical triangles (no centre spread) still end in small leaves.
+    #[test]
+    fn duplicates_split_by_count() {
+        let t = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
+        let (bvh, _) = soup(&vec![t; 1000]);
+        let counts = || bvh.nodes.iter().flat_map(|n| n.count);
+        assert!(counts().all(|c| c as usize <= sah::MAX_LEAF * 2));
+        assert_eq!(counts().map(|c| c as usize).sum::<usize>(), 1000);
+    }
+}

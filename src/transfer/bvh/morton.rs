@@ -1,0 +1,126 @@
+//! The upper levels of a large tree, split at Morton-code boundaries: one sort, then no pass
+//! over every item per level. Binned SAH builds only ranges of [`SAH_RANGE`] or fewer, whose
+//! items fit in a core's cache.
+
+use super::bounds::{bounds_of, Aabb, Item};
+use super::collapse::Upper;
+use super::node::Node;
+use super::sah;
+use glam::Vec3A;
+
+/// From this many triangles on, the upper levels are split here rather than by SAH.
+pub(super) const MORTON_MIN: usize = 64 * 1024;
+const SAH_RANGE: usize = 256;
+/// A Morton key holds the code above a triangle's index, so keys are unique and sort alike on
+/// any thread count: 12 bits an axis over 28 bits of index (HIGHs up to 268M triangles).
+const INDEX_BITS: u32 = 28;
+const INDEX_MASK: u64 = (1 << INDEX_BITS) - 1;
+const AXIS_BITS: u32 = 12;
+
+/// Whether a tree over `n` triangles gets Morton-split upper levels: enough of them that a
+/// pass over all per level costs more than the sort, few enough that an index fits its key.
+pub(super) fn applies(n: usize) -> bool {
+    (MORTON_MIN..1 << INDEX_BITS).contains(&n)
+}
+
+/// Sorts `items` by the Morton code of their centres within `centres` (their centres' bounds)
+/// and builds the tree over them.
+pub(super) fn build(items: &mut Vec<Item>, centres: &Aabb) -> Upper {
+    use rayon::prelude::*;
+    let mut keys = morton_keys(items, centres);
+    let sorted: Vec<Item> = keys.par_iter().map(|k| items[(k & INDEX_MASK) as usize]).collect();
+    *items = sorted;
+    keys.iter_mut().for_each(|k| *k >>= INDEX_BITS);
+    build_upper(items, &keys, 0)
+}
+
+/// Each item's key (Morton code of its box's centre over the centres' bounds `c`, then its
+/// index), sorted.
+fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
+    use rayon::prelude::*;
+    let n = items.len();
+    let cells = (1u32 << AXIS_BITS) as f32;
+    let extent = c.max - c.min;
+    let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
+    let keys: Vec<u64> = items
+        .par_iter()
+        .enumerate()
+        .map(|(i, it)| {
+            let q = ((it.centre() - c.min) * scale).min(Vec3A::splat(cells - 1.0));
+            let code = spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2;
+            code << INDEX_BITS | i as u64
+        })
+        .collect();
+    // One pass on the code's top 12 bits into buckets, then each bucket sorted on its own, on
+    // every core: the keys are unique, so any sort gives the one order.
+    let top = |k: u64| (k >> (INDEX_BITS + 2 * AXIS_BITS)) as usize;
+    let mut start = vec![0usize; (1 << AXIS_BITS) + 1];
+    keys.iter().for_each(|&k| start[top(k) + 1] += 1);
+    for d in 1..start.len() {
+        start[d] += start[d - 1];
+    }
+    let mut sorted = vec![0u64; n];
+    let mut next = start.clone();
+    for &k in &keys {
+        let d = top(k);
+        sorted[next[d]] = k;
+        next[d] += 1;
+    }
+    drop(keys);
+    let mut buckets: Vec<&mut [u64]> = Vec::with_capacity(1 << AXIS_BITS);
+    let mut rest = sorted.as_mut_slice();
+    for d in 0..1 << AXIS_BITS {
+        let (b, r) = rest.split_at_mut(start[d + 1] - start[d]);
+        buckets.push(b);
+        rest = r;
+    }
+    buckets.into_par_iter().for_each(|b| b.sort_unstable());
+    sorted
+}
+
+/// The low 12 bits of `x`, two zero bits after each.
+fn spread(x: u64) -> u64 {
+    let mut x = x & 0xfff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+fn upper_bounds(u: &Upper) -> Aabb {
+    let n = u.node();
+    Aabb { min: Vec3A::from(n.min), max: Vec3A::from(n.max) }
+}
+
+/// The upper levels over Morton-sorted items: each split where the codes' highest differing
+/// bit flips; ranges of [`SAH_RANGE`] or fewer (or of one code) are built by binned SAH.
+fn build_upper(items: &mut [Item], codes: &[u64], offset: usize) -> Upper {
+    let last = codes.len() - 1;
+    if items.len() <= SAH_RANGE || codes[0] == codes[last] {
+        let bc = bounds_of(items);
+        return Upper::range(sah::build_par(items, offset, bc));
+    }
+    let bit = 63 - (codes[0] ^ codes[last]).leading_zeros();
+    let mid = codes.partition_point(|c| c >> bit & 1 == 0);
+    let (l, r) = items.split_at_mut(mid);
+    let (cl, cr) = codes.split_at(mid);
+    let (left, right) = rayon::join(|| build_upper(l, cl, offset), || build_upper(r, cr, offset + mid));
+    let mut b = upper_bounds(&left);
+    b.join(&upper_bounds(&right));
+    Upper::Split(Node::inner(&b, 0), Box::new(left), Box::new(right))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spread_leaves_two_zero_bits_after_each() {
+        for x in [0u64, 1, 0b101, 0xfff, 0xabc] {
+            let mut want = 0;
+            (0..12).for_each(|b| want |= (x >> b & 1) << (3 * b));
+            assert_eq!(spread(x), want, "{x:#x}");
+        }
+    }
+}
