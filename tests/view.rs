@@ -17,6 +17,24 @@ fn only_the_scene_model_reads_mode_dequantizes_or_walks_nodes() {
     );
 }
 
+/// Dequantization is the model's (`scene::dequant`, called by `scene::view`): the readers below it
+/// in `src/format/` hand over streams as stored and never name it.
+#[test]
+fn the_readers_do_not_dequantize() {
+    let mut stack = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/format")];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let text = std::fs::read_to_string(&p).unwrap();
+                assert!(!text.contains("dequant"), "{} names dequant (it belongs to scene::view)", p.display());
+            }
+        }
+    }
+}
+
 /// OBJ and PLY UVs are turned to glTF's orientation once, at load: no flag travels with a
 /// primitive for stages to branch on, in any module.
 #[test]

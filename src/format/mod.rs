@@ -4,7 +4,6 @@
 //! the image reader the same decoded image, so no stage learns where a mesh or a texture came
 //! from. Compression (meshopt) is decoded right after parsing, as gltfpack's `parsegltf.cpp` does.
 
-pub mod dequant;
 pub mod draco;
 mod gltf_read;
 mod gltf_write;

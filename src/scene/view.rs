@@ -23,7 +23,7 @@ use super::material::{Materials, PrimNeed, TextureUse, UvTransform};
 use super::nodes::Instance;
 use super::{to_triangle_list, PrimRef, Primitive, Scene, Stream};
 use crate::error::Result;
-use crate::format::dequant;
+use super::dequant;
 use serde_json::Value;
 use std::borrow::Cow;
 
