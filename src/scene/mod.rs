@@ -7,8 +7,8 @@
 //! longer referenced. OBJ input is converted into the same model on reading.
 
 pub mod accessor;
-pub mod dequant;
 pub(crate) mod compact;
+pub mod dequant;
 pub mod leave_out;
 pub mod material;
 pub mod nodes;
