@@ -10,7 +10,6 @@ pub mod draco;
 mod gltf_read;
 mod gltf_write;
 pub mod image;
-mod ktx2;
 mod meshopt;
 mod number;
 pub mod obj;

@@ -1,7 +1,7 @@
 //! Reading Wavefront OBJ (+ MTL) into the glTF model: the geometry through the parallel parser
-//! (`parse.rs`, `block.rs`, `piece.rs`, `fast.rs`), the MTL libraries through `tobj` (`mtl.rs`,
-//! the only part of it still used). Each run of one name and material becomes a primitive,
-//! renumbered as tobj numbered its models, so welding sees what it always saw.
+//! (`parse.rs`, `block.rs`, `piece.rs`, `fast.rs`), the MTL libraries through `tobj` (`mtl.rs`).
+//! Each run of one name and material becomes a primitive, its corners renumbered in first-use
+//! order as tobj numbers a model's, so the welded output matches tobj's reading of the file.
 //!
 //! OBJ's UVs run v up; they are turned into glTF's v down on building (`format::build`), so no
 //! stage after the reader knows the mesh came from an OBJ (MikkTSpace's sign flips with v, and
@@ -27,6 +27,8 @@ pub fn read_file(path: &Path, opts: &ReadOptions) -> Result<Scene> {
     build_scene(path, data, opts)
 }
 
+/// Reads OBJ bytes already in memory; `path` names them in messages and MTL names resolve
+/// beside it.
 pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     let data = parse::parse_bytes(path, bytes, &opts.progress)?;
     build_scene(path, data, opts)

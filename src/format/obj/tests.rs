@@ -1,4 +1,4 @@
-//! The parser and its glue against `tobj` (the reader they replace) on the same inputs: every
+//! The parser and its glue against `tobj` (the reference reading of OBJ) on the same inputs: every
 //! object, material, position, normal, UV and index list as tobj numbered them.
 
 use super::*;
