@@ -6,7 +6,7 @@
 //! `BUMPBAKE_CORPUS`, which `.ci/run` sets; under `CI=true` a missing corpus fails the test.
 
 mod common;
-use bumpbake::format::dequant::{transformed_uvs, unit_normals};
+use bumpbake::scene::dequant::{transformed_uvs, unit_normals};
 use bumpbake::tangent::mikk::{generate, Engine};
 use bumpbake::tangent::TriMesh;
 use common::*;

@@ -17,12 +17,10 @@ fn only_the_scene_model_reads_mode_dequantizes_or_walks_nodes() {
     );
 }
 
-/// OBJ and PLY UVs are turned to glTF's orientation once, at load: no flag travels with a
-/// primitive for stages to branch on, in any module.
-#[test]
-fn no_stage_branches_on_the_source_uv_orientation() {
-    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut stack = vec![src];
+/// Every `.rs` file below `src/{dir}`, with its text.
+fn rust_files(dir: &str) -> Vec<(std::path::PathBuf, String)> {
+    let mut stack = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src").join(dir)];
+    let mut out = Vec::new();
     while let Some(dir) = stack.pop() {
         for e in std::fs::read_dir(&dir).unwrap() {
             let p = e.unwrap().path();
@@ -30,9 +28,28 @@ fn no_stage_branches_on_the_source_uv_orientation() {
                 stack.push(p);
             } else if p.extension().is_some_and(|x| x == "rs") {
                 let text = std::fs::read_to_string(&p).unwrap();
-                assert!(!text.contains("uv_v_up"), "{} names uv_v_up", p.display());
+                out.push((p, text));
             }
         }
+    }
+    out
+}
+
+/// Dequantization is the model's (`scene::dequant`, called by `scene::view`): the readers below it
+/// in `src/format/` hand over streams as stored and never name it.
+#[test]
+fn the_readers_do_not_dequantize() {
+    for (p, text) in rust_files("format") {
+        assert!(!text.contains("dequant"), "{} names dequant (it belongs to scene::view)", p.display());
+    }
+}
+
+/// OBJ and PLY UVs are turned to glTF's orientation once, at load: no flag travels with a
+/// primitive for stages to branch on, in any module.
+#[test]
+fn no_stage_branches_on_the_source_uv_orientation() {
+    for (p, text) in rust_files("") {
+        assert!(!text.contains("uv_v_up"), "{} names uv_v_up", p.display());
     }
 }
 

@@ -1,25 +1,21 @@
 //! Every file format bumpbake reads or writes, in a room of its own below the stages.
 //!
-//! Each reader hands over the same [`Scene`] (glTF JSON + buffers, OBJ converted on reading) and
-//! the image reader the same decoded image, so no stage learns where a mesh or a texture came
-//! from. Compression (meshopt, Draco) is decoded right after parsing, as gltfpack's `parsegltf.cpp`
-//! does for meshopt.
+//! Each reader hands over the same [`Scene`] (glTF JSON + buffers; OBJ and PLY converted on
+//! reading, from the [`stored::StoredMesh`] both parsers fill) and the image reader the same
+//! decoded image, so no stage learns where a mesh or a texture came from. Compression (meshopt,
+//! Draco) is decoded right after parsing, as gltfpack's `parsegltf.cpp` does for meshopt.
 
-pub mod dequant;
+mod build;
 pub mod draco;
 mod gltf_read;
 mod gltf_write;
 pub mod image;
-mod ktx2;
 mod meshopt;
-mod obj;
-mod obj_block;
-mod obj_fast;
-pub mod obj_parse;
+mod number;
+pub mod obj;
 pub mod ply;
-mod ply_ascii;
-mod ply_binary;
 pub mod raw;
+pub mod stored;
 pub mod uri;
 
 pub use gltf_write::{write, WriteOptions, WriteStats};
@@ -52,7 +48,7 @@ impl Scene {
         if ext == "obj" {
             obj::read(path, bytes, opts)
         } else if ext == "ply" || ply::is_ply(bytes) {
-            obj::ply_scene(path, ply::parse(path, bytes)?, opts)
+            ply::scene(path, ply::parse(path, bytes)?, opts)
         } else if bytes.starts_with(b"glTF") || ext == "glb" {
             gltf_read::read_glb(path, bytes, opts)
         } else if ext == "gltf" || bytes.first().map(|b| *b == b'{').unwrap_or(false) {
@@ -101,38 +97,4 @@ impl Scene {
             .map(<[u8]>::to_vec)
             .map_err(|why| self.err(format!("image {i}: bufferView {v} {why}")))
     }
-}
-
-/// The first vertex with a coordinate that is not finite, as an error naming `path` (every
-/// reader's words for it); on every core.
-fn check_finite(path: &Path, p: &[[f32; 3]]) -> Result<()> {
-    use rayon::prelude::*;
-    match p.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
-        Some(i) => Err(Error::input(path, format!("vertex {} has a non-finite coordinate", i + 1))),
-        None => Ok(()),
-    }
-}
-
-/// A sign, then 1 to 18 decimal digits (so it never overflows), as `str::parse::<i64>` reads it
-/// without its UTF-8 check; `None` for anything else, a longer number included. The OBJ and ASCII
-/// PLY readers' one integer parser.
-#[inline]
-fn short_int(t: &[u8]) -> Option<i64> {
-    let (neg, digits) = match t.first()? {
-        b'-' => (true, &t[1..]),
-        b'+' => (false, &t[1..]),
-        _ => (false, t),
-    };
-    if digits.is_empty() || digits.len() > 18 {
-        return None;
-    }
-    let mut v = 0i64;
-    for &c in digits {
-        let d = c.wrapping_sub(b'0');
-        if d > 9 {
-            return None;
-        }
-        v = v * 10 + d as i64;
-    }
-    Some(if neg { -v } else { v })
 }

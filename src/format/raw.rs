@@ -1,15 +1,13 @@
-//! A triangle mesh as a file stores it, before any welding: what a baker's HIGH needs, and what
-//! the OBJ and PLY readers hand over before a [`Scene`] is built from them.
+//! HIGH for `bake --from`: every triangle a mesh file shows, in world space, before any welding.
 //!
 //! Each attribute keeps its own index stream (an OBJ face corner names `v`, `vt` and `vn`
-//! separately), so a 20M-triangle sculpt is held as the file holds it, with no per-corner hash
-//! maps. Positions are in the mesh's world space: glTF node transforms are applied here (OBJ and
-//! PLY have none), normals through the normal matrix. UVs are in glTF's convention (v down).
+//! separately), so a 20M-triangle sculpt is held with no per-corner hash maps and, from OBJ and
+//! PLY, in the arrays their parsers filled. Positions are in world space (glTF node transforms are
+//! applied here; OBJ and PLY have none), normals unit and through the normal matrix, UVs in glTF's
+//! convention (v down).
 
-use super::check_finite;
-use super::obj_parse::{ObjData, Statement, MISSING};
-use super::ply::PlyMesh;
-use crate::error::{Error, Result};
+use super::stored::{check_finite, check_finite_uv, runs, v_down, StoredMesh, MISSING};
+use crate::error::Result;
 use crate::scene::nodes::instances;
 use crate::scene::normals::unit_or_up;
 use crate::scene::{to_triangle_list, PrimRef, ReadOptions, Scene};
@@ -27,6 +25,7 @@ pub struct Part {
     pub start: u32,
 }
 
+/// A mesh as HIGH holds it (see the module): world space, unit normals, v down.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RawMesh {
     pub positions: Vec<[f32; 3]>,
@@ -44,12 +43,10 @@ pub struct RawMesh {
     pub parts: Vec<Part>,
 }
 
-impl RawMesh {
-    /// The triangle range of part `k`.
-    pub fn part_range(&self, k: usize) -> std::ops::Range<usize> {
-        let end = self.parts.get(k + 1).map_or(self.triangles.len(), |p| p.start as usize);
-        self.parts[k].start as usize..end
-    }
+/// The triangle range of part `k` of `parts`, in a mesh of `triangles` triangles.
+pub fn part_range(parts: &[Part], k: usize, triangles: usize) -> std::ops::Range<usize> {
+    let end = parts.get(k + 1).map_or(triangles, |p| p.start as usize);
+    parts[k].start as usize..end
 }
 
 /// Reads any mesh file bumpbake reads as a [`RawMesh`]: every triangle primitive the scene shows,
@@ -60,82 +57,58 @@ impl RawMesh {
 pub fn read_raw(path: &Path, opts: &ReadOptions) -> Result<RawMesh> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
-        "obj" => from_obj(path, super::obj_parse::parse_file(path, &opts.progress)?),
+        "obj" => from_obj(path, super::obj::parse::parse_file(path, &opts.progress)?),
         "ply" => from_ply(path, super::ply::read_file(path)?),
         _ => from_scene(&Scene::read(path, opts)?),
     }
 }
 
-/// An OBJ file's arrays as a mesh: parts at `o`/`g` and at `usemtl` changes, UVs flipped to
-/// glTF's convention once, normals made unit (zero ones point up, as for every OBJ read).
-/// A kind of index some corners lack (a `vt` here and there) is dropped whole.
-pub fn from_obj(path: &Path, d: ObjData) -> Result<RawMesh> {
+/// An OBJ file's arrays as a mesh: parts at `o`/`g` and at `usemtl` changes.
+pub fn from_obj(path: &Path, d: StoredMesh) -> Result<RawMesh> {
+    // The PLY parser checks its positions as it reads them; the OBJ parser leaves it to the glue,
+    // which names the object on the Scene path.
     check_finite(path, &d.positions)?;
-    // Whole triangles per item: a flattened parallel iterator costs more than the test itself.
-    let complete = |t: &Vec<[u32; 3]>| !t.is_empty() && !t.par_iter().any(|c| c.contains(&MISSING));
-    let (with_n, with_t) = (complete(&d.tri_n), complete(&d.tri_t));
-    let mut parts = Vec::new();
-    let mut cur = Part { name: "unnamed_object".into(), material: None, start: 0 };
-    for (at, s) in d.statements {
-        let next = match s {
-            Statement::Name(n) => Part { name: n, material: cur.material.clone(), start: at },
-            Statement::Material(m) if cur.material.as_deref() != Some(m.as_str()) => {
-                Part { name: cur.name.clone(), material: Some(m), start: at }
-            }
-            Statement::Material(_) => continue,
-        };
-        if at > cur.start {
-            parts.push(std::mem::replace(&mut cur, next));
-        } else {
-            cur = next;
-        }
-    }
-    if (d.tri_v.len() as u32) > cur.start {
-        parts.push(cur);
-    }
-    let mut out = RawMesh { positions: d.positions, triangles: d.tri_v, parts, ..Default::default() };
-    if with_n {
-        out.normals = d.normals;
-        out.normals.par_iter_mut().for_each(|n| *n = unit_or_up(*n));
-        out.normal_triangles = d.tri_n;
-    }
-    if with_t {
-        out.uvs = flip_v(d.uvs);
-        check_finite_uv(path, &out.uvs)?;
-        out.uv_triangles = d.tri_t;
-    }
-    Ok(out)
+    from_stored(path, d, "unnamed_object")
 }
 
 /// A PLY mesh as one part named after the file.
-pub fn from_ply(path: &Path, p: PlyMesh) -> Result<RawMesh> {
-    let name = path.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
-    let parts = if p.triangles.is_empty() { Vec::new() } else { vec![Part { name, material: None, start: 0 }] };
-    let mut out = RawMesh { positions: p.positions, parts, ..Default::default() };
-    if !p.normals.is_empty() {
-        out.normals = p.normals;
+pub fn from_ply(path: &Path, p: StoredMesh) -> Result<RawMesh> {
+    from_stored(path, p, &super::ply::mesh_name(path))
+}
+
+/// A stored mesh's arrays taken over: UVs turned v down, normals made unit (zero ones point up,
+/// as for every OBJ and PLY read). A kind of index some corners lack (a `vt` here and there) is
+/// dropped whole; values one per position get `triangles` as their index stream.
+fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<RawMesh> {
+    // Whole triangles per item: a flattened parallel iterator costs more than the test itself.
+    let indices = |own: Vec<[u32; 3]>, values: usize, triangles: &[[u32; 3]]| {
+        if values == 0 {
+            None
+        } else if own.is_empty() {
+            Some(triangles.to_vec())
+        } else {
+            (!own.par_iter().any(|c| c.contains(&MISSING))).then_some(own)
+        }
+    };
+    let normal_triangles = indices(m.normal_triangles, m.normals.len(), &m.triangles);
+    let uv_triangles = indices(m.uv_triangles, m.uvs.len(), &m.triangles);
+    let parts = runs(&m.statements, m.triangles.len(), first_name, |name| Some(name.to_string()))
+        .into_iter()
+        .map(|r| Part { name: r.name, material: r.material, start: r.tris.start as u32 })
+        .collect();
+    let mut out = RawMesh { positions: m.positions, triangles: m.triangles, parts, ..Default::default() };
+    if let Some(t) = normal_triangles {
+        out.normals = m.normals;
         out.normals.par_iter_mut().for_each(|n| *n = unit_or_up(*n));
-        out.normal_triangles = p.triangles.clone();
+        out.normal_triangles = t;
     }
-    if !p.uvs.is_empty() {
-        out.uvs = flip_v(p.uvs);
+    if let Some(t) = uv_triangles {
+        out.uvs = m.uvs;
+        v_down(&mut out.uvs);
         check_finite_uv(path, &out.uvs)?;
-        out.uv_triangles = p.triangles.clone();
+        out.uv_triangles = t;
     }
-    out.triangles = p.triangles;
     Ok(out)
-}
-
-fn flip_v(mut uvs: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
-    uvs.par_iter_mut().for_each(|uv| uv[1] = 1.0 - uv[1]);
-    uvs
-}
-
-fn check_finite_uv(path: &Path, uv: &[[f32; 2]]) -> Result<()> {
-    match uv.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
-        Some(i) => Err(Error::input(path, format!("texture coordinate {} is not finite", i + 1))),
-        None => Ok(()),
-    }
 }
 
 /// A scene's shown triangle primitives as one [`RawMesh`] in world space.

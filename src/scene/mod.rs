@@ -8,6 +8,7 @@
 
 pub mod accessor;
 pub(crate) mod compact;
+pub mod dequant;
 pub mod leave_out;
 pub mod material;
 pub mod nodes;

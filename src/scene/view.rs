@@ -19,11 +19,11 @@
 //! The file format a scene came from is not part of the view: every reader hands over glTF's
 //! conventions, and `Scene.source_format` exists for reports only.
 
+use super::dequant;
 use super::material::{Materials, PrimNeed, TextureUse, UvTransform};
 use super::nodes::Instance;
 use super::{to_triangle_list, PrimRef, Primitive, Scene, Stream};
 use crate::error::Result;
-use crate::format::dequant;
 use serde_json::Value;
 use std::borrow::Cow;
 

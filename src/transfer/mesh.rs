@@ -9,7 +9,7 @@
 //! normalised per vertex, and `w` negated on a mirroring node.
 
 use crate::error::{Error, Result};
-use crate::format::raw::{read_raw, RawMesh};
+use crate::format::raw::{part_range, read_raw, RawMesh};
 use crate::scene::nodes::{instances, Instance};
 use crate::scene::to_triangle_list;
 use crate::scene::{smooth_vertex_normals, PrimRef, PrimView, ReadOptions, Scene};
@@ -89,11 +89,6 @@ impl High {
             self.normals.extend(normals);
         }
     }
-}
-
-fn part_range(parts: &[crate::format::raw::Part], k: usize, n: usize) -> std::ops::Range<usize> {
-    let end = parts.get(k + 1).map_or(n, |p| p.start as usize);
-    parts[k].start as usize..end
 }
 
 /// A named run of HIGH triangles, from one file.
@@ -309,7 +304,7 @@ pub fn high(
         }
         let base_tri = h.triangles.len() as u32;
         for (k, p) in raw.parts.iter().enumerate() {
-            let r = raw.part_range(k);
+            let r = part_range(&raw.parts, k, raw.triangles.len());
             let (start, end) = (base_tri + r.start as u32, base_tri + r.end as u32);
             match parts.last_mut() {
                 Some(last) if last.file == f && last.name == p.name && last.end == start => last.end = end,

@@ -24,7 +24,7 @@
 
 mod basis;
 
-use super::image::{check_size_within, Limits};
+use super::{check_size_within, Limits};
 use image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgba};
 
 /// How a KTX2 file stores its base level, as far as bumpbake is concerned.

@@ -5,7 +5,7 @@
 //!
 //! Formats are told by their magic bytes, never by a file name or a glTF `mimeType`: PNG, JPEG,
 //! WebP (lossy and lossless), TIFF, OpenEXR and KTX2 (Basis Universal and the plain formats:
-//! `super::ktx2`) are decoded; the other formats glTF extensions allow, and the KTX2 variants
+//! `ktx2/`) are decoded; the other formats glTF extensions allow, and the KTX2 variants
 //! not read, are named in the error, so that callers can say plainly what was not read.
 //!
 //! Decoding does not trust the file. An image header can claim any size (a 100-byte PNG can say
@@ -16,6 +16,8 @@
 //!
 //! Commands that only carry images along (`tangents` copies or embeds them byte for byte) never
 //! decode them at all.
+
+mod ktx2;
 
 use image::{DynamicImage, ImageDecoder, ImageError, ImageFormat, ImageReader};
 use std::io::Cursor;
@@ -187,7 +189,7 @@ fn describe(kind: Kind, e: ImageError) -> String {
 /// for everything else, broken files included: decoding those says what is wrong.
 pub fn not_decoded_why(bytes: &[u8]) -> Option<String> {
     match Kind::sniff(bytes) {
-        Kind::Ktx2 => super::ktx2::not_decoded(bytes),
+        Kind::Ktx2 => ktx2::not_decoded(bytes),
         Kind::Unknown => None,
         k if !k.is_decoded() => Some(not_decoded(k)),
         _ => None,
@@ -218,7 +220,7 @@ pub fn dimensions(bytes: &[u8]) -> Result<(u32, u32), String> {
 /// [`dimensions`] under other limits.
 pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Result<(u32, u32), String> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
-        return super::ktx2::dimensions_within(bytes, limits);
+        return ktx2::dimensions_within(bytes, limits);
     }
     let (kind, mut r) = reader(bytes, Cursor::new(bytes))?;
     // Only the header is read here; the size checks below give the clearer message.
@@ -248,7 +250,7 @@ pub struct Header {
 /// checked against the limits (describing a huge image is fine; decoding it is not).
 pub fn header(bytes: &[u8]) -> Result<Header, String> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
-        let (width, height, colour, bits_per_channel, variant) = super::ktx2::describe(bytes)?;
+        let (width, height, colour, bits_per_channel, variant) = ktx2::describe(bytes)?;
         return Ok(Header { kind: Kind::Ktx2, width, height, colour, bits_per_channel, variant: Some(variant) });
     }
     let (kind, mut r) = reader(bytes, Cursor::new(bytes))?;
@@ -299,7 +301,7 @@ pub fn decode(bytes: &[u8]) -> Result<DynamicImage, String> {
 /// Decodes an image after checking its header against `limits`.
 pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
-        return super::ktx2::decode_within(bytes, limits);
+        return ktx2::decode_within(bytes, limits);
     }
     dimensions_within(bytes, limits)?;
     if Kind::sniff(bytes) == Kind::Jpeg && !jpeg_is_whole(bytes) {

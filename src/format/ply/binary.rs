@@ -7,7 +7,7 @@
 //! come before it; then the blocks are read in parallel, each into its own part of the output.
 //! Errors are those of the sequential reader, for the same first record.
 
-use super::ply::{fan, Element, Ty};
+use super::{fan, Element, Ty};
 use rayon::prelude::*;
 
 /// Faces a parallel task reads.

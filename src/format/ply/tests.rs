@@ -63,7 +63,7 @@ fn sample(enc: &str) -> Vec<u8> {
     out
 }
 
-fn read(bytes: &[u8]) -> std::result::Result<PlyMesh, String> {
+fn read(bytes: &[u8]) -> std::result::Result<StoredMesh, String> {
     parse(Path::new("scan.ply"), bytes).map_err(|e| e.to_string())
 }
 
@@ -213,13 +213,12 @@ fn parallel_binary_reads_as_ascii_does() {
 /// reader reads it to the same mesh.
 #[test]
 fn ascii_lines_are_read_in_parallel_and_other_layouts_sequentially() {
-    use crate::format::ply_ascii;
     let b = polygons("ascii", 150_000);
     let (_, els, body) = header(&b).unwrap();
-    let cols = ply_ascii::Columns { xyz: [0, 1, 2], nrm: None, uv: None };
-    let ((p, n, uv), used) = ply_ascii::vertices(&els[0], &b[body..], &cols).expect("one vertex a line");
+    let cols = ascii::Columns { xyz: [0, 1, 2], nrm: None, uv: None };
+    let ((p, n, uv), used) = ascii::vertices(&els[0], &b[body..], &cols).expect("one vertex a line");
     assert_eq!((p.len(), n.len(), uv.len()), (5000, 0, 0));
-    let (tris, end) = ply_ascii::faces(&els[1], 1, &b[body + used..], 5000).expect("one face a line");
+    let (tris, end) = ascii::faces(&els[1], 1, &b[body + used..], 5000).expect("one face a line");
     assert_eq!(body + used + end, b.len());
     let whole = read(&b).unwrap();
     assert_eq!((&whole.positions, &whole.triangles), (&p, &tris));
@@ -228,7 +227,7 @@ fn ascii_lines_are_read_in_parallel_and_other_layouts_sequentially() {
     let at = body + used + "1 0.5".len();
     assert_eq!(split[at], b' ');
     split[at] = b'\n';
-    assert!(ply_ascii::faces(&els[1], 1, &split[body + used..], 5000).is_none());
+    assert!(ascii::faces(&els[1], 1, &split[body + used..], 5000).is_none());
     assert_eq!(read(&split).unwrap(), whole);
 }
 
@@ -237,13 +236,12 @@ fn ascii_lines_are_read_in_parallel_and_other_layouts_sequentially() {
 /// rounding (Blender writes about eight significant digits).
 #[test]
 fn blenders_ascii_ply_reads_in_parallel_as_its_binary_ply() {
-    use crate::format::ply_ascii;
     let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/blender_scene/moved");
     let text = std::fs::read(d.join("torus_high_ascii.ply")).unwrap();
     let (_, els, body) = header(&text).unwrap();
-    let cols = ply_ascii::Columns { xyz: [0, 1, 2], nrm: Some([3, 4, 5]), uv: None };
-    let (_, used) = ply_ascii::vertices(&els[0], &text[body..], &cols).expect("a vertex a line");
-    ply_ascii::faces(&els[1], 0, &text[body + used..], els[0].count).expect("a face a line");
+    let cols = ascii::Columns { xyz: [0, 1, 2], nrm: Some([3, 4, 5]), uv: None };
+    let (_, used) = ascii::vertices(&els[0], &text[body..], &cols).expect("a vertex a line");
+    ascii::faces(&els[1], 0, &text[body + used..], els[0].count).expect("a face a line");
     let a = read(&text).unwrap();
     let b = read(&std::fs::read(d.join("torus_high.ply")).unwrap()).unwrap();
     assert_eq!((a.triangles.len(), &a.triangles), (9216, &b.triangles));

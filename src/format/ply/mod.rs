@@ -7,26 +7,25 @@
 //! fanned from their first corner as OBJ faces are. Other elements and properties are skipped.
 //! Every count is checked against the bytes that remain before anything is allocated, so a
 //! header that claims billions of vertices is an error, not an allocation.
-//! Texture v is kept as stored (up, as in OBJ); the glue converts it to glTF's convention.
-//! The `vertex` and `face` elements are read on every core: binary ones always
-//! (`ply_binary.rs`), ASCII ones when each record is one line (`ply_ascii.rs`; anything else is
-//! read here, record by record).
+//! Texture v is kept as stored (up, as in OBJ); `scene.rs` and `raw.rs` convert it to glTF's
+//! convention. The `vertex` and `face` elements are read on every core: binary ones always
+//! (`binary.rs`), ASCII ones when each record is one line (`ascii.rs`; anything else is read
+//! here, record by record).
 
-use super::obj_parse::parse_f32;
-use super::ply_ascii as ascii;
-use super::ply_binary as binary;
+mod ascii;
+mod binary;
+mod scene;
+
+pub use scene::scene;
+
+use super::number::parse_f32;
+use super::stored::{check_finite, StoredMesh};
 use crate::error::{Error, Result};
 use std::path::Path;
 
-/// A PLY mesh as stored: per-vertex attributes and triangles.
-#[derive(Debug, Default, Clone, PartialEq)]
-pub struct PlyMesh {
-    pub positions: Vec<[f32; 3]>,
-    /// Empty when the vertices have no nx/ny/nz.
-    pub normals: Vec<[f32; 3]>,
-    /// Empty when the vertices have no texture coordinates; v up.
-    pub uvs: Vec<[f32; 2]>,
-    pub triangles: Vec<[u32; 3]>,
+/// The name of the one mesh a PLY file holds: its file name without the extension.
+pub fn mesh_name(path: &Path) -> String {
+    path.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().into_owned())
 }
 
 #[derive(Clone, Copy, PartialEq, Debug)]
@@ -88,7 +87,7 @@ pub(super) struct Element {
 
 /// Reads the PLY file at `path`, through a memory map when it is a file (a scan's PLY is not
 /// copied whole into memory beside what is read from it).
-pub fn read_file(path: &Path) -> Result<PlyMesh> {
+pub fn read_file(path: &Path) -> Result<StoredMesh> {
     let cannot = |e: std::io::Error| Error::input(path, format!("cannot read: {e}"));
     let file = std::fs::File::open(path).map_err(cannot)?;
     let meta = file.metadata().map_err(cannot)?;
@@ -109,11 +108,11 @@ pub fn is_ply(bytes: &[u8]) -> bool {
 }
 
 /// Parses PLY bytes; `path` names the file in messages.
-pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<StoredMesh> {
     let err = |m: String| Error::input(path, m);
     let (enc, elements, body) = header(bytes).map_err(|m| err(format!("bad PLY header: {m}")))?;
     let mut cur = Cursor { b: &bytes[body..], i: 0, enc };
-    let mut mesh = PlyMesh::default();
+    let mut mesh = StoredMesh::default();
     let mut have_vertices = false;
     for el in &elements {
         // Each record takes at least this many bytes, so a count the file cannot hold is caught
@@ -182,7 +181,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh> {
                         return Err(truncated((b.len() / stride) as u64));
                     }
                     mesh.positions = binary::columns(b, n, stride, [cols[x], cols[y], cols[z]], big);
-                    super::check_finite(path, &mesh.positions)?;
+                    check_finite(path, &mesh.positions)?;
                     if let Some(c) = nrm {
                         mesh.normals = binary::columns(b, n, stride, c.map(|j| cols[j]), big);
                     }
@@ -424,5 +423,5 @@ impl Cursor<'_> {
 }
 
 #[cfg(test)]
-#[path = "ply_tests.rs"]
+#[path = "tests.rs"]
 mod tests;

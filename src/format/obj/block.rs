@@ -10,8 +10,9 @@
 //! whatever the piece size or thread count. The pieces' arrays are reused from block to block and
 //! copied into the growing output on every core, each at its place.
 
-use super::obj_parse::{count, Counts, Forward, ObjData, Piece, MISSING};
+use super::piece::{count, Counts, Forward, Piece};
 use crate::error::{Error, Result};
+use crate::format::stored::{StoredMesh, MISSING};
 use crate::progress::Reporter;
 use memchr::memchr;
 use rayon::prelude::*;
@@ -20,7 +21,7 @@ use std::path::Path;
 
 #[derive(Default)]
 pub(super) struct Acc {
-    data: ObjData,
+    data: StoredMesh,
     any_t: bool,
     any_n: bool,
     forward: Vec<Forward>,
@@ -96,7 +97,7 @@ impl Acc {
     /// Appends the block's pieces, all parsed, in file order.
     fn place(&mut self, pieces: &mut [Piece], bases: &[Counts]) {
         let d = &mut self.data;
-        let tris_before = d.tri_v.len();
+        let tris_before = d.triangles.len();
         let mut at = tris_before;
         for (p, base) in pieces.iter_mut().zip(bases) {
             for (t, s) in p.statements.drain(..) {
@@ -109,9 +110,9 @@ impl Acc {
         append(&mut d.positions, pieces, [0.0; 3], |p| (&p.pos, p.pos.len()));
         append(&mut d.normals, pieces, [0.0; 3], |p| (&p.nrm, p.nrm.len()));
         append(&mut d.uvs, pieces, [0.0; 2], |p| (&p.uv, p.uv.len()));
-        append(&mut d.tri_v, pieces, [0; 3], |p| (&p.tv, p.tv.len()));
+        append(&mut d.triangles, pieces, [0; 3], |p| (&p.tv, p.tv.len()));
         // A kind of index some pieces lack is filled in as missing for their triangles.
-        let lists = [(&mut self.any_t, &mut d.tri_t, false), (&mut self.any_n, &mut d.tri_n, true)];
+        let lists = [(&mut self.any_t, &mut d.uv_triangles, false), (&mut self.any_n, &mut d.normal_triangles, true)];
         for (any, list, normals) in lists {
             fn of(p: &Piece, normals: bool) -> (bool, &[[u32; 3]]) {
                 if normals {
@@ -130,7 +131,7 @@ impl Acc {
         }
     }
 
-    pub(super) fn finish(mut self, path: &Path) -> Result<ObjData> {
+    pub(super) fn finish(mut self, path: &Path) -> Result<StoredMesh> {
         let d = &mut self.data;
         let totals = [d.positions.len(), d.uvs.len(), d.normals.len()];
         for f in &self.forward {
@@ -148,11 +149,13 @@ impl Acc {
                 ));
             }
         }
-        if d.uvs.is_empty() {
-            d.tri_t.clear();
+        // Values without indices would read as one per position (PLY's way): those no corner
+        // names are dropped, as indices into values the file never defines are.
+        if d.uvs.is_empty() || d.uv_triangles.is_empty() {
+            (d.uvs, d.uv_triangles) = Default::default();
         }
-        if d.normals.is_empty() {
-            d.tri_n.clear();
+        if d.normals.is_empty() || d.normal_triangles.is_empty() {
+            (d.normals, d.normal_triangles) = Default::default();
         }
         Ok(self.data)
     }

@@ -1,7 +1,8 @@
-//! The parser and its glue against `tobj` (the reader they replace) on the same inputs: every
+//! The parser and its glue against `tobj` (the reference reading of OBJ) on the same inputs: every
 //! object, material, position, normal, UV and index list as tobj numbered them.
 
 use super::*;
+use std::io::BufReader;
 use std::path::PathBuf;
 
 fn tobj_models(path: &Path, bytes: &[u8]) -> Vec<tobj::Model> {
@@ -13,10 +14,13 @@ fn tobj_models(path: &Path, bytes: &[u8]) -> Vec<tobj::Model> {
 }
 
 fn ours(path: &Path, bytes: &[u8]) -> Vec<(String, Option<usize>, Model)> {
-    let data = obj_parse::parse_bytes(path, bytes, &Default::default()).unwrap();
+    let data = parse::parse_bytes(path, bytes, &Default::default()).unwrap();
     let (_, ids, _) = load_materials(path, path.parent().unwrap(), &data.mtllibs, &ReadOptions::default()).unwrap();
     let mut remap = Remaps::new(&data);
-    runs(&data, &ids).into_iter().map(|r| (r.name.clone(), r.material, remap.model(&data, r.tris))).collect()
+    runs(&data.statements, data.triangles.len(), "unnamed_object", |m| ids.get(m).copied())
+        .into_iter()
+        .map(|r| (r.name.clone(), r.material, remap.model(&data, r.tris)))
+        .collect()
 }
 
 fn same(path: &Path, bytes: &[u8]) {

@@ -8,8 +8,8 @@
 //! triangle's tangent (dP/du) maps to exactly `M` times itself, and orthogonality to the normal
 //! survives (normals map by `M^-T`); only the angle weights of MikkTSpace's vertex average change.
 
-use crate::scene::accessor::{Stream, FLOAT};
-use crate::scene::material::UvTransform;
+use super::accessor::{Stream, FLOAT};
+use super::material::UvTransform;
 use std::borrow::Cow;
 
 /// UVs as the texture lookup sees them.

@@ -7,8 +7,8 @@
 //! blank line, a value that is not a number, an index out of range, a missing last newline) makes
 //! it give up, and the sequential reader reads the element again and names the first bad record.
 
-use super::obj_parse::parse_f32;
-use super::ply::{fan, Element};
+use super::{fan, Element};
+use crate::format::number::{parse_f32, short_int};
 use memchr::{memchr, memchr_iter};
 use rayon::prelude::*;
 
@@ -103,7 +103,7 @@ fn lines(piece: &[u8]) -> impl Iterator<Item = &[u8]> {
 /// what that leaves (a number too long for it, or not a number).
 #[inline]
 pub(super) fn int(t: &[u8]) -> Option<i64> {
-    super::short_int(t).or_else(|| std::str::from_utf8(t).ok()?.parse().ok())
+    short_int(t).or_else(|| std::str::from_utf8(t).ok()?.parse().ok())
 }
 
 /// Vertex columns as the sequential reader keeps them.

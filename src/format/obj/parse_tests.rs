@@ -1,6 +1,8 @@
 use super::*;
+use crate::format::number::{lead_f32, parse_f32};
+use crate::format::stored::{Statement, MISSING};
 
-fn parse(s: &str) -> ObjData {
+fn parse(s: &str) -> StoredMesh {
     parse_bytes(Path::new("t.obj"), s.as_bytes(), &Default::default()).unwrap()
 }
 
@@ -32,9 +34,9 @@ fn every_listed_syntax() {
     assert!(d.positions[0][1].is_sign_negative());
     assert_eq!(d.uvs, vec![[0.5, -0.0], [1.0, 1.0]]);
     assert_eq!(d.normals, vec![[0.0, 0.0, 1.0]]);
-    assert_eq!(d.tri_v, vec![[0, 1, 2], [0, 1, 2], [0, 2, 3]]);
-    assert_eq!(d.tri_t, vec![[0, MISSING, 0], [0, 1, MISSING], [0, MISSING, MISSING]]);
-    assert_eq!(d.tri_n, vec![[0, 0, MISSING], [0, MISSING, MISSING], [0, MISSING, MISSING]]);
+    assert_eq!(d.triangles, vec![[0, 1, 2], [0, 1, 2], [0, 2, 3]]);
+    assert_eq!(d.uv_triangles, vec![[0, MISSING, 0], [0, 1, MISSING], [0, MISSING, MISSING]]);
+    assert_eq!(d.normal_triangles, vec![[0, 0, MISSING], [0, MISSING, MISSING], [0, MISSING, MISSING]]);
     assert_eq!(
         d.statements,
         vec![
@@ -50,17 +52,17 @@ fn every_listed_syntax() {
 #[test]
 fn a_polygon_is_fanned_from_its_first_corner() {
     let d = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv -1 1 0\nf 1 2 3 4 5\n");
-    assert_eq!(d.tri_v, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
-    assert!(d.tri_t.is_empty() && d.tri_n.is_empty());
+    assert_eq!(d.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
+    assert!(d.uv_triangles.is_empty() && d.normal_triangles.is_empty());
 }
 
 #[test]
 fn faces_may_come_before_what_they_name() {
     let d = parse("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
-    assert_eq!(d.tri_v, vec![[0, 1, 2]]);
+    assert_eq!(d.triangles, vec![[0, 1, 2]]);
     // vt/vn indices into a kind the file never defines are ignored (as tobj did).
     let d = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n");
-    assert!(d.tri_t.is_empty() && d.tri_n.is_empty());
+    assert!(d.uv_triangles.is_empty() && d.normal_triangles.is_empty());
 }
 
 #[test]
@@ -168,7 +170,7 @@ fn any_piece_size_gives_the_same_result() {
         }
     }
     let whole = parse(&s);
-    assert!(whole.tri_v.len() > 60);
+    assert!(whole.triangles.len() > 60);
     for piece in [1, 2, 3, 5, 7, 16, 64, 1000] {
         assert_eq!(pieces(&s, piece).unwrap(), whole, "piece {piece}");
     }
@@ -189,7 +191,7 @@ fn any_piece_size_gives_the_same_result() {
 }
 
 /// `s` parsed with pieces of about `piece` bytes, both from memory and through a reader.
-fn pieces(s: &str, piece: usize) -> std::result::Result<ObjData, String> {
+fn pieces(s: &str, piece: usize) -> std::result::Result<StoredMesh, String> {
     let path = Path::new("t.obj");
     let mapped = parse_pieces::<true>(path, s.as_bytes(), piece, &Reporter::none()).map_err(|e| e.to_string());
     let read = parse_reader(path, s.as_bytes(), piece).map_err(|e| e.to_string());
@@ -207,7 +209,7 @@ fn pieces_that_need_their_base_read_as_the_whole() {
         s += if i % 4 == 3 { "f 1/1/1 -1/-1/-1 -2/-2/-2\n" } else { "f 1 2 3 4 5 6 7\n" };
     }
     let whole = parse(&s);
-    assert_eq!(whole.tri_v[0], [2, 1, 0]);
+    assert_eq!(whole.triangles[0], [2, 1, 0]);
     for piece in [1, 4, 9, 30, 200] {
         assert_eq!(pieces(&s, piece).unwrap(), whole, "piece {piece}");
     }
