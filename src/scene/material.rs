@@ -13,7 +13,7 @@ use super::{as_index, PrimRef, Scene};
 use serde::Serialize;
 use serde_json::{json, Value};
 
-pub use super::texcoord::UvTransform;
+pub use super::uv_transform::UvTransform;
 
 /// How a texture's texels are to be read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
