@@ -440,3 +440,60 @@ fn bad_input_exits_2_with_one_line_naming_the_file() {
     assert!(err.contains("badtex.glb") && err.contains("image"), "{err}");
     assert!(!out_png.exists());
 }
+
+// ---------- strips and fans ----------
+
+/// Strips and fans are drawn as the triangles they make, exactly as `tangents` processes them: the
+/// same image as the triangle list with those triangles (odd strip triangles wound back, as glTF
+/// says).
+#[test]
+fn strips_and_fans_draw_as_the_triangles_they_make() {
+    let d = scratch_dir("preview_strip_fan");
+    // A wavy band: strip vertices alternate bottom and top; a fan around its first vertex.
+    let n = 8;
+    let mut pos = Vec::new();
+    let mut uv = Vec::new();
+    for i in 0..=n {
+        let x = i as f32 / n as f32;
+        for y in [0.0f32, 1.0] {
+            pos.push([x * 2.0 - 1.0, y * 2.0 - 1.0, 0.2 * (x * 6.0).sin()]);
+            uv.push([x, 1.0 - y]);
+        }
+    }
+    let count = pos.len() as u16;
+    let strip: Vec<u16> = (0..count).collect();
+    let fan: Vec<u16> = std::iter::once(0).chain((1..count).rev()).collect();
+    let strip_list: Vec<u16> = (2..strip.len())
+        .flat_map(|k| {
+            if k % 2 == 0 {
+                [strip[k - 2], strip[k - 1], strip[k]]
+            } else {
+                [strip[k - 1], strip[k - 2], strip[k]]
+            }
+        })
+        .collect();
+    let fan_list: Vec<u16> = (2..fan.len()).flat_map(|k| [fan[0], fan[k - 1], fan[k]]).collect();
+    let write = |name: &str, idx: &[u16], mode: Option<u32>| {
+        let mut g = Gltf::new();
+        let p = g.floats(&pos, Some(34962));
+        let t = g.floats(&uv, Some(34962));
+        let i = g.indices(idx);
+        let tex = g.texture();
+        let m = g.material(json!({ "normalTexture": { "index": tex } }));
+        let mut prim = json!({ "attributes": { "POSITION": p, "TEXCOORD_0": t }, "indices": i, "material": m });
+        if let Some(mode) = mode {
+            prim["mode"] = json!(mode);
+        }
+        g.mesh(prim);
+        let f = d.join(format!("{name}.glb"));
+        g.write_glb(&f);
+        let png = d.join(format!("{name}.png"));
+        preview(&[s(&f), "-o", s(&png), "--size", "96x96"]);
+        std::fs::read(png).unwrap()
+    };
+    let strip_png = write("strip", &strip, Some(5));
+    assert_eq!(strip_png, write("strip_list", &strip_list, None), "a strip draws as its triangle list");
+    let fan_png = write("fan", &fan, Some(6));
+    assert_eq!(fan_png, write("fan_list", &fan_list, None), "a fan draws as its triangle list");
+    assert_ne!(strip_png, fan_png, "the two are different meshes (the strip is drawn at all)");
+}
