@@ -3,8 +3,12 @@
 //! The library does all the work; the `bumpbake` binary only parses arguments and reports.
 //! Every subcommand follows `docs/conventions.md` (copied from the project's shared contract).
 //!
-//! - [`scene`]: the one in-memory model every stage shares, with its readers (OBJ, glTF, GLB)
-//!   and writer (glTF, GLB).
+//! - [`scene`]: the one in-memory model every stage shares: the glTF JSON as read (its shape
+//!   checked once, [`scene::shape`]), buffers, a renderer's view of each primitive, materials,
+//!   node placement.
+//! - [`format`]: every file format read or written into that model: OBJ, PLY, glTF/GLB (meshopt
+//!   and Draco decoded on reading), images and KTX2.
+//! - [`bake`], [`inspect`]: the `bake` and `inspect` commands.
 //! - [`tangent`]: MikkTSpace tangent frames, fallback frames, vertex split and merge.
 //! - [`normalmap`]: height maps to tangent-space normal maps.
 //! - [`validate`]: tangent-frame, handedness and normal-map checks.

@@ -11,7 +11,7 @@ use crate::error::Result;
 use crate::scene::nodes::instances;
 use crate::scene::normals::unit_or_up;
 use crate::scene::{to_triangle_list, PrimRef, ReadOptions, Scene};
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -127,33 +127,27 @@ pub fn from_scene(scene: &Scene) -> Result<RawMesh> {
             .and_then(|n| nodes.and_then(|a| a.get(n)).and_then(|n| n.get("name")).and_then(|s| s.as_str()))
             .or_else(|| mesh_json.get("name").and_then(|s| s.as_str()))
             .map_or_else(|| format!("mesh {}", inst.mesh), str::to_string);
-        let m3 = Mat3::from_mat4(inst.world);
-        let normal_matrix = m3.inverse().transpose();
-        let mirrored = inst.mirrored();
+        let place = inst.placement();
         let prims = mesh_json.get("primitives").and_then(|p| p.as_array()).map_or(0, |p| p.len());
         for k in 0..prims {
             let r = PrimRef { mesh: inst.mesh, primitive: k };
             let pj = scene.prim_json(r);
-            if !crate::scene::Mode::of(pj).has_triangles() || pj.pointer("/attributes/POSITION").is_none() {
+            if !crate::scene::view::is_surface(scene, r) {
                 continue;
             }
             let p = to_triangle_list(scene.primitive(r)?);
             let base = out.positions.len() as u32;
             let material = pj.get("material").and_then(|m| m.as_u64()).map(|m| m.to_string());
             out.parts.push(Part { name: name.clone(), material, start: out.triangles.len() as u32 });
-            out.positions
-                .extend(p.positions().into_iter().map(|q| inst.world.transform_point3(Vec3::from(q)).to_array()));
+            out.positions.extend(p.positions().into_iter().map(|q| place.point(Vec3::from(q)).to_array()));
             match p.attr("NORMAL") {
                 Some(n) if with_normals => out.normals.extend(
-                    n.to_f32::<3>().into_iter().map(|v| (normal_matrix * Vec3::from(v)).normalize_or_zero().to_array()),
+                    n.to_f32::<3>().into_iter().map(|v| place.normal(Vec3::from(v)).normalize_or_zero().to_array()),
                 ),
                 _ => with_normals = false,
             }
             for t in p.indices.chunks_exact(3) {
-                let t = [base + t[0], base + t[1], base + t[2]];
-                // A mirroring transform turns counter-clockwise into clockwise; swapping two
-                // corners keeps the face's front where its normals point.
-                out.triangles.push(if mirrored { [t[0], t[2], t[1]] } else { t });
+                out.triangles.push(place.triangle([base + t[0], base + t[1], base + t[2]]));
             }
         }
     }

@@ -316,17 +316,19 @@ impl Cx<'_> {
 }
 
 fn place(l: &Local, inst: &Instance, material: usize, source: PrimRef) -> Draw {
-    let (m3, nm) = (inst.tangent_matrix(), inst.normal_matrix());
-    let positions = l.positions.iter().map(|&p| inst.world.transform_point3(p)).collect();
-    let normals: Vec<Vec3> = l.normals.iter().map(|&n| unit_or(nm * n, Vec3::Z)).collect();
+    let place = inst.placement();
+    let positions = l.positions.iter().map(|&p| place.point(p)).collect();
+    let normals: Vec<Vec3> = l.normals.iter().map(|&n| unit_or(place.normal(n), Vec3::Z)).collect();
     let tangents = l
         .tangents
         .iter()
         .zip(&normals)
-        .map(|(&t, &n)| sane_tangent((m3 * t.truncate()).extend(inst.world_w(t.w)), n))
+        .map(|(&t, &n)| {
+            let (v, w) = place.tangent(t.to_array());
+            sane_tangent(v.extend(w), n)
+        })
         .collect();
-    let triangles =
-        if inst.mirrored() { l.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect() } else { l.triangles.clone() };
+    let triangles = l.triangles.iter().map(|&t| place.triangle(t)).collect();
     Draw { positions, normals, tangents, uvs: l.uvs.clone(), triangles, material, source }
 }
 

@@ -48,6 +48,57 @@ impl Instance {
             w
         }
     }
+
+    /// The instance's matrices, worked out once, for placing many vertices.
+    pub fn placement(&self) -> Placement {
+        Placement {
+            world: self.world,
+            tangent: self.tangent_matrix(),
+            normal: self.normal_matrix(),
+            mirrored: self.mirrored(),
+        }
+    }
+}
+
+/// How geometry is placed in the world by an [`Instance`]: the one place positions, normals,
+/// tangents and winding are moved there (HIGH's reader, LOW for the baker, the preview). What
+/// comes out is not normalised: each caller normalises in the precision it works in.
+#[derive(Debug, Clone, Copy)]
+pub struct Placement {
+    world: Mat4,
+    tangent: Mat3,
+    normal: Mat3,
+    mirrored: bool,
+}
+
+impl Placement {
+    pub fn point(&self, p: Vec3) -> Vec3 {
+        self.world.transform_point3(p)
+    }
+
+    /// A normal's direction in the world (by [`Instance::normal_matrix`]).
+    pub fn normal(&self, n: Vec3) -> Vec3 {
+        self.normal * n
+    }
+
+    /// A tangent's direction in the world and its `w` ([`Instance::world_w`]).
+    pub fn tangent(&self, t: [f32; 4]) -> (Vec3, f32) {
+        (self.tangent * Vec3::new(t[0], t[1], t[2]), if self.mirrored { -t[3] } else { t[3] })
+    }
+
+    /// A triangle wound so that its front stays where its normals point: a mirroring transform
+    /// turns counter-clockwise into clockwise, and swapping two corners turns it back.
+    pub fn triangle(&self, t: [u32; 3]) -> [u32; 3] {
+        if self.mirrored {
+            [t[0], t[2], t[1]]
+        } else {
+            t
+        }
+    }
+
+    pub fn mirrored(&self) -> bool {
+        self.mirrored
+    }
 }
 
 /// Every mesh the scene shows, once per node that shows it, with its world transform, in the

@@ -109,6 +109,12 @@ impl PrimView {
         }
     }
 
+    /// Whether the primitive is a surface something can be drawn or baked from: triangles, a
+    /// strip or a fan, with POSITION. The one answer every stage asks for ([`is_surface`]).
+    pub fn is_surface(&self) -> bool {
+        self.mode.has_triangles() && self.has_position
+    }
+
     /// Whether the primitive declares attribute `name`.
     pub fn has(&self, name: &str) -> bool {
         self.attributes.iter().any(|a| a == name)
@@ -143,6 +149,12 @@ impl PrimView {
         let normal_repair = super::normals::repair_normals(&mut primitive);
         Ok(Geometry { primitive, tangent_uvs: self.tangent_uvs(), normal_repair })
     }
+}
+
+/// [`PrimView::is_surface`] without the materials a view reads.
+pub fn is_surface(scene: &Scene, r: PrimRef) -> bool {
+    let pj = scene.prim_json(r);
+    Mode::of(pj).has_triangles() && pj.pointer("/attributes/POSITION").is_some()
 }
 
 /// The view of every primitive of `scene`, in document order.

@@ -119,11 +119,6 @@ fn dvec(p: [f32; 3]) -> DVec3 {
     DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
-pub fn is_triangles(scene: &Scene, r: PrimRef) -> bool {
-    let pj = scene.prim_json(r);
-    crate::scene::Mode::of(pj).has_triangles() && pj.pointer("/attributes/POSITION").is_some()
-}
-
 fn node_name(scene: &Scene, n: usize) -> String {
     scene
         .array("nodes")
@@ -265,12 +260,13 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
                 out.tangents.extend(tangents);
             }
             Some(m) => {
-                let inst = Instance { mesh: r.mesh, node: None, world: m };
-                let (m3, nm) = (inst.tangent_matrix(), inst.normal_matrix());
-                out.normals.extend(normals.iter().map(|&n| Vec3A::from(nm * Vec3::from(n)).normalize_or_zero()));
+                let place = Instance { mesh: r.mesh, node: None, world: m }.placement();
+                out.normals
+                    .extend(normals.iter().map(|&n| Vec3A::from(place.normal(Vec3::from(n))).normalize_or_zero()));
                 out.tangents.extend(tangents.into_iter().map(|t| {
-                    let v = (m3 * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
-                    [v.x, v.y, v.z, inst.world_w(t[3])]
+                    let (v, w) = place.tangent(t);
+                    let v = v.normalize_or_zero();
+                    [v.x, v.y, v.z, w]
                 }));
             }
         }
@@ -328,7 +324,8 @@ pub fn cage(
     low: &Low,
 ) -> Result<Vec<[Vec3A; 3]>> {
     let scene = Scene::read(path, read)?;
-    let prims: Vec<PrimRef> = scene.primitives().into_iter().filter(|&r| is_triangles(&scene, r)).collect();
+    let prims: Vec<PrimRef> =
+        scene.primitives().into_iter().filter(|&r| crate::scene::view::is_surface(&scene, r)).collect();
     let same = placed.iter().all(|p| prims.contains(&p.prim));
     let chosen: Vec<PrimRef> = if same { placed.iter().map(|p| p.prim).collect() } else { prims };
     let mut corners = Vec::new();

@@ -122,7 +122,7 @@ pub fn material_prims(scene: &Scene, m: usize) -> Vec<PrimRef> {
     scene
         .primitives()
         .into_iter()
-        .filter(|&r| scene.material_index(r) == Some(m) && mesh::is_triangles(scene, r))
+        .filter(|&r| scene.material_index(r) == Some(m) && crate::scene::view::is_surface(scene, r))
         .collect()
 }
 
