@@ -161,16 +161,7 @@ impl Glb {
         json["buffers"][0]["byteLength"] = bin.len().into();
         let mut j = serde_json::to_vec(&json).unwrap();
         j.resize(j.len().next_multiple_of(4), b' ');
-        let mut out = b"glTF".to_vec();
-        out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&((28 + j.len() + bin.len()) as u32).to_le_bytes());
-        out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"JSON");
-        out.extend_from_slice(&j);
-        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(&bin);
-        out
+        common::glb_bytes(&j, &bin)
     }
 }
 

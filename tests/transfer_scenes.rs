@@ -90,17 +90,7 @@ fn scene_glb(meshes: &[(&str, Vec<Prim>)], nodes: Value, materials: &[&str]) -> 
     while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&((28 + js.len() + bin.len()) as u32).to_le_bytes());
-    out.extend_from_slice(&(js.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&js);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    out
+    common::glb_bytes(&js, &bin)
 }
 
 /// A one-mesh scene: `mesh` under one node `name` with transform `m`.

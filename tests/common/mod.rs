@@ -242,18 +242,7 @@ impl Gltf {
         while !b.len().is_multiple_of(4) {
             b.push(0);
         }
-        let total = 12 + 8 + j.len() + 8 + b.len();
-        let mut out = Vec::new();
-        out.extend_from_slice(b"glTF");
-        out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&(total as u32).to_le_bytes());
-        out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"JSON");
-        out.extend_from_slice(&j);
-        out.extend_from_slice(&(b.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(&b);
-        std::fs::write(path, out).unwrap();
+        std::fs::write(path, glb_bytes(&j, &b)).unwrap();
     }
 
     /// Writes `name.gltf` + `name.bin` into `dir`; returns the .gltf path.
@@ -343,5 +332,20 @@ pub fn stage_lines_where(found: impl Fn(&str) -> bool) -> Vec<String> {
             }
         }
     }
+    out
+}
+
+/// A GLB of JSON and binary chunks whose lengths are already multiples of 4.
+pub fn glb_bytes(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(28 + json.len() + bin.len());
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&((28 + json.len() + bin.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(json);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(bin);
     out
 }
