@@ -46,3 +46,46 @@ impl<T, E: std::fmt::Display> Context<T> for std::result::Result<T, E> {
         self.map_err(|e| Error::input(path, e.to_string()))
     }
 }
+
+/// What went wrong inside some bytes, before the caller knows which file they came from: the
+/// words a user reads and, where a library reported it, the error underneath (kept as the
+/// `source`, so the chain is there for whoever walks it). The readers' and decoders' error;
+/// [`Context::in_file`] turns it into an [`Error`] that names the file.
+#[derive(Debug, thiserror::Error)]
+#[error("{msg}")]
+pub struct Fault {
+    msg: String,
+    #[source]
+    source: Option<Box<dyn std::error::Error + Send + Sync + 'static>>,
+}
+
+impl Fault {
+    pub fn new(msg: impl Into<String>) -> Self {
+        Fault { msg: msg.into(), source: None }
+    }
+
+    /// A fault whose cause is `source`; `msg` says what it meant here.
+    pub fn caused_by(msg: impl Into<String>, source: impl std::error::Error + Send + Sync + 'static) -> Self {
+        Fault { msg: msg.into(), source: Some(Box::new(source)) }
+    }
+
+    /// The same fault, its words prefixed with where it happened.
+    pub fn at(self, place: impl std::fmt::Display) -> Self {
+        Fault { msg: format!("{place}: {}", self.msg), source: self.source }
+    }
+}
+
+impl From<String> for Fault {
+    fn from(msg: String) -> Self {
+        Fault::new(msg)
+    }
+}
+
+impl From<&str> for Fault {
+    fn from(msg: &str) -> Self {
+        Fault::new(msg)
+    }
+}
+
+/// A reader's result, its file not named yet.
+pub type Faulty<T> = std::result::Result<T, Fault>;

@@ -131,9 +131,12 @@ pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -
     Ok((out, check))
 }
 
-fn encode(img: image::DynamicImage) -> std::result::Result<Vec<u8>, String> {
+fn encode(img: image::DynamicImage) -> crate::error::Faulty<Vec<u8>> {
     let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| format!("cannot encode as PNG: {e}"))?;
+    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| {
+        let why = format!("cannot encode as PNG: {e}");
+        crate::error::Fault::caused_by(why, e)
+    })?;
     Ok(out.into_inner())
 }
 

@@ -64,7 +64,7 @@ pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut Vec<Vec<u8>>) -> 
 }
 
 /// Decodes one Draco stream, stopping at `limits`.
-pub fn decode_stream(stream: &[u8], limits: DecodeLimits) -> std::result::Result<Mesh, String> {
+pub fn decode_stream(stream: &[u8], limits: DecodeLimits) -> crate::error::Faulty<Mesh> {
     let mut mesh = Mesh::new();
     MeshDecoder::new()
         .decode(&mut DecoderBuffer::new(stream).with_limits(limits), &mut mesh)
@@ -78,7 +78,7 @@ pub fn decode_stream(stream: &[u8], limits: DecodeLimits) -> std::result::Result
 
 /// Decodes a stream and reads every value of every attribute and every face as [`decode_all`]
 /// does: what the fuzz target and the mutation campaign run. Returns the point and face counts.
-pub fn decode_and_read(stream: &[u8]) -> std::result::Result<(usize, usize), String> {
+pub fn decode_and_read(stream: &[u8]) -> crate::error::Faulty<(usize, usize)> {
     let mesh = decode_stream(stream, DecodeLimits::fuzzing())?;
     let n = mesh.num_points();
     for a in 0..mesh.num_attributes() {
@@ -113,7 +113,7 @@ fn limits(json: &Value, prim: &Value) -> DecodeLimits {
 }
 
 /// The bytes of the stream's buffer view, checked against its buffer.
-fn stream_bytes<'a>(json: &Value, buffers: &'a [Vec<u8>], ext: &Value) -> std::result::Result<&'a [u8], String> {
+fn stream_bytes<'a>(json: &Value, buffers: &'a [Vec<u8>], ext: &Value) -> crate::error::Faulty<&'a [u8]> {
     let v = ext.get("bufferView").and_then(as_index).ok_or("no bufferView")?;
     let view = json.pointer(&format!("/bufferViews/{v}")).ok_or(format!("bufferView {v} does not exist"))?;
     let b = view.get("buffer").and_then(as_index).ok_or(format!("bufferView {v} has no buffer"))?;
@@ -122,7 +122,7 @@ fn stream_bytes<'a>(json: &Value, buffers: &'a [Vec<u8>], ext: &Value) -> std::r
     buffers
         .get(b)
         .and_then(|buf| buf.get(off..off.checked_add(len as usize)?))
-        .ok_or(format!("bufferView {v} runs past the end of buffer {b}"))
+        .ok_or(format!("bufferView {v} runs past the end of buffer {b}").into())
 }
 
 /// The decoded data, accumulated into one new buffer.
@@ -135,7 +135,7 @@ struct Out {
 
 impl Out {
     /// The primitive with its accessors pointed at the decoded data and without the extension.
-    fn place(&mut self, json: &mut Value, prim: &Value, mesh: &Mesh) -> std::result::Result<Value, String> {
+    fn place(&mut self, json: &mut Value, prim: &Value, mesh: &Mesh) -> crate::error::Faulty<Value> {
         let mut prim = prim.clone();
         let ext = prim.pointer(&format!("/extensions/{EXT}")).cloned().unwrap_or_default();
         let ids = ext.get("attributes").and_then(|a| a.as_object()).ok_or("no attributes")?;
@@ -150,13 +150,16 @@ impl Out {
                 mesh.attribute_by_unique_id(id).ok_or(format!("attribute {name}: the stream has no attribute {id}"))?;
             let (ct, comps, count) = layout(json, acc)?;
             if count != n {
-                return Err(format!("the stream decodes {n} points, but accessor {acc} ({name}) declares {count}"));
+                return Err(
+                    format!("the stream decodes {n} points, but accessor {acc} ({name}) declares {count}").into()
+                );
             }
             if attr.num_components() as usize != comps {
                 return Err(format!(
                     "attribute {name}: the stream has {} components, accessor {acc} declares {comps}",
                     attr.num_components()
-                ));
+                )
+                .into());
             }
             let size = component_size(ct).unwrap_or(4);
             // Each element of a vertex attribute starts on a 4-byte boundary (glTF 3.6.2.4).
@@ -188,13 +191,14 @@ impl Out {
                         let acc = as_index(i).ok_or("indices names no accessor")?;
                         let (ct, comps, count) = layout(json, acc)?;
                         if comps != 1 || !matches!(ct, 5121 | UNSIGNED_SHORT | UNSIGNED_INT) {
-                            return Err(format!("indices accessor {acc} is not unsigned integer scalars"));
+                            return Err(format!("indices accessor {acc} is not unsigned integer scalars").into());
                         }
                         if count != faces.len() {
                             return Err(format!(
                                 "the stream decodes {} triangles, but indices accessor {acc} declares {count} indices",
                                 faces.len() / 3
-                            ));
+                            )
+                            .into());
                         }
                         (Some(acc), ct)
                     }
@@ -219,7 +223,7 @@ impl Out {
                 crate::scene::set_key(&mut prim, "indices", json!(acc));
             }
             POINTS if faces.is_empty() && prim.get("indices").is_none() => {}
-            _ => return Err(format!("mode {mode} with {} decoded triangles is not supported", faces.len() / 3)),
+            _ => return Err(format!("mode {mode} with {} decoded triangles is not supported", faces.len() / 3).into()),
         }
         let exts = prim.get_mut("extensions").and_then(Value::as_object_mut).ok_or("extensions is not an object")?;
         exts.remove(EXT);
@@ -268,13 +272,17 @@ impl Out {
 }
 
 /// An accessor's componentType, component count and count.
-fn layout(json: &Value, acc: usize) -> std::result::Result<(u32, usize, usize), String> {
+fn layout(json: &Value, acc: usize) -> crate::error::Faulty<(u32, usize, usize)> {
     let a = json.pointer(&format!("/accessors/{acc}")).ok_or(format!("accessor {acc} does not exist"))?;
     let ct = a.get("componentType").and_then(|c| c.as_u64()).unwrap_or(0) as u32;
     let ty = a.get("type").and_then(|t| t.as_str()).unwrap_or("");
     let comps = match component_count(ty) {
         Some(c) if component_size(ct).is_some() && !ty.starts_with("MAT") => c,
-        _ => return Err(format!("accessor {acc} (componentType {ct}, type '{ty}') cannot hold decoded Draco data")),
+        _ => {
+            return Err(
+                format!("accessor {acc} (componentType {ct}, type '{ty}') cannot hold decoded Draco data").into()
+            )
+        }
     };
     let count = a.get("count").and_then(|c| c.as_u64()).ok_or(format!("accessor {acc} has no count"))?;
     Ok((ct, comps, count as usize))
@@ -285,8 +293,8 @@ fn for_each_value(
     attr: &PointAttribute,
     points: usize,
     comps: usize,
-    f: &mut dyn FnMut(f64) -> std::result::Result<(), String>,
-) -> std::result::Result<(), String> {
+    f: &mut dyn FnMut(f64) -> crate::error::Faulty<()>,
+) -> crate::error::Faulty<()> {
     let dt = attr.data_type();
     let width = dt.byte_length();
     if width == 0 {
@@ -335,13 +343,13 @@ fn number(dt: DataType, b: &[u8]) -> f64 {
 /// Appends `v` as component type `ct` and returns the value stored. Integers are copied only when
 /// they fit; floats go only to float accessors (rounding them to integers would invent a
 /// quantization the file did not ask for).
-fn put(out: &mut Vec<u8>, ct: u32, v: f64, from_float: bool) -> std::result::Result<f64, String> {
+fn put(out: &mut Vec<u8>, ct: u32, v: f64, from_float: bool) -> crate::error::Faulty<f64> {
     if ct == FLOAT {
         out.extend_from_slice(&(v as f32).to_le_bytes());
         return Ok(v as f32 as f64);
     }
     if from_float {
-        return Err(format!("the stream holds floats, the accessor declares componentType {ct}"));
+        return Err(format!("the stream holds floats, the accessor declares componentType {ct}").into());
     }
     let (lo, hi) = match ct {
         5120 => (i8::MIN as f64, i8::MAX as f64),
@@ -351,7 +359,7 @@ fn put(out: &mut Vec<u8>, ct: u32, v: f64, from_float: bool) -> std::result::Res
         _ => (0.0, u32::MAX as f64),
     };
     if !(lo..=hi).contains(&v) {
-        return Err(format!("value {v} does not fit componentType {ct}"));
+        return Err(format!("value {v} does not fit componentType {ct}").into());
     }
     match ct {
         5120 => out.push(v as i8 as u8),
@@ -402,13 +410,13 @@ impl Bounds {
 }
 
 /// The faces as a flat index list, each index checked against the point count.
-fn faces(mesh: &Mesh) -> std::result::Result<Vec<u32>, String> {
+fn faces(mesh: &Mesh) -> crate::error::Faulty<Vec<u32>> {
     let n = mesh.num_points();
     let mut out = Vec::with_capacity(mesh.num_faces() * 3);
     for f in mesh.faces() {
         for p in f {
             if p.0 as usize >= n {
-                return Err(format!("a face names point {}, past the {n} points", p.0));
+                return Err(format!("a face names point {}, past the {n} points", p.0).into());
             }
             out.push(p.0);
         }

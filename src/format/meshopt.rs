@@ -99,21 +99,21 @@ struct Job {
 }
 
 impl Job {
-    fn read(ext: &Value, view: &Value) -> std::result::Result<Job, String> {
+    fn read(ext: &Value, view: &Value) -> crate::error::Faulty<Job> {
         let num = |v: &Value, key: &str| v.get(key).and_then(|x| x.as_u64()).map(|x| x as usize);
         let need = |key: &str| num(ext, key).ok_or_else(|| format!("no {key}"));
         let mode = match ext.get("mode").and_then(|m| m.as_str()) {
             Some("ATTRIBUTES") => Mode::Attributes,
             Some("TRIANGLES") => Mode::Triangles,
             Some("INDICES") => Mode::Indices,
-            other => return Err(format!("unknown mode {}", other.unwrap_or("(none)"))),
+            other => return Err(format!("unknown mode {}", other.unwrap_or("(none)")).into()),
         };
         let filter = match ext.get("filter").and_then(|m| m.as_str()).unwrap_or("NONE") {
             "NONE" => Filter::None,
             "OCTAHEDRAL" => Filter::Octahedral,
             "QUATERNION" => Filter::Quaternion,
             "EXPONENTIAL" => Filter::Exponential,
-            other => return Err(format!("unknown filter {other}")),
+            other => return Err(format!("unknown filter {other}").into()),
         };
         let job = Job {
             src_buffer: ext.get("buffer").and_then(as_index).ok_or("no buffer")?,
@@ -135,18 +135,21 @@ impl Job {
             _ => return Err("filters apply only to ATTRIBUTES".into()),
         };
         if !stride_ok || job.stride == 0 {
-            return Err(format!("byteStride {} is not allowed here", job.stride));
+            return Err(format!("byteStride {} is not allowed here", job.stride).into());
         }
         if job.mode == Mode::Triangles && !job.count.is_multiple_of(3) {
-            return Err(format!("TRIANGLES count {} is not a multiple of 3", job.count));
+            return Err(format!("TRIANGLES count {} is not a multiple of 3", job.count).into());
         }
         match job.count.checked_mul(job.stride) {
             Some(n) if n <= job.dst_len => Ok(job),
-            _ => Err(format!("{} elements of {} bytes do not fit its {} bytes", job.count, job.stride, job.dst_len)),
+            _ => {
+                Err(format!("{} elements of {} bytes do not fit its {} bytes", job.count, job.stride, job.dst_len)
+                    .into())
+            }
         }
     }
 
-    fn decode(&self, src: &[u8], dst: &mut [u8]) -> std::result::Result<(), String> {
+    fn decode(&self, src: &[u8], dst: &mut [u8]) -> crate::error::Faulty<()> {
         let out = &mut dst[..self.count * self.stride];
         // SAFETY: `out` holds exactly count * stride bytes (checked in `read`), which is what each
         // decoder writes; the decoders read at most `src.len()` bytes of `src`.
@@ -161,7 +164,7 @@ impl Job {
             }
         };
         if rc != 0 {
-            return Err(format!("the compressed data is damaged (decoder error {rc})"));
+            return Err(format!("the compressed data is damaged (decoder error {rc})").into());
         }
         // SAFETY: each filter rewrites count elements of `stride` bytes in place, within `out`;
         // the strides were checked against what each filter accepts.

@@ -96,7 +96,7 @@ impl Texture {
     /// Decodes image bytes (any format [`crate::format::image`] reads, under its texture limits).
     /// Colour textures are sRGB-encoded in glTF and are linearised here; data textures (normal
     /// maps) must keep their encoded values, so `srgb` is false.
-    pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
+    pub fn decode(bytes: &[u8], srgb: bool) -> crate::error::Faulty<Texture> {
         let img = crate::format::image::decode(bytes)?;
         let rgba = img.to_rgba32f();
         let (w, h) = (rgba.width() as usize, rgba.height() as usize);

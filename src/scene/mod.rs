@@ -202,14 +202,14 @@ impl Scene {
 
     /// `len` bytes at `off` of buffer `b`, or why they cannot be read (said of the buffer view
     /// that names them).
-    pub fn buffer_range(&self, b: usize, off: usize, len: usize) -> std::result::Result<&[u8], String> {
+    pub fn buffer_range(&self, b: usize, off: usize, len: usize) -> crate::error::Faulty<&[u8]> {
         if self.absent_buffers.contains(&b) {
-            return Err(format!("reads buffer {b}, which has no data (no uri, and not a GLB's binary chunk)"));
+            return Err(format!("reads buffer {b}, which has no data (no uri, and not a GLB's binary chunk)").into());
         }
         self.buffers
             .get(b)
             .and_then(|buf| buf.get(off..off.checked_add(len)?))
-            .ok_or_else(|| format!("(bytes {off}..{}) runs past the end of buffer {b}", off.saturating_add(len)))
+            .ok_or_else(|| format!("(bytes {off}..{}) runs past the end of buffer {b}", off.saturating_add(len)).into())
     }
 
     /// The image index a texture index shows, if any.

@@ -308,9 +308,9 @@ pub(super) fn fan<T: Copy>(idx: &[T]) -> impl Iterator<Item = [T; 3]> + '_ {
 }
 
 /// The encoding, the elements and where the body starts.
-fn header(b: &[u8]) -> std::result::Result<(Encoding, Vec<Element>, usize), String> {
+fn header(b: &[u8]) -> crate::error::Faulty<(Encoding, Vec<Element>, usize)> {
     if !is_ply(b) {
-        return Err("the file does not start with the line 'ply'".to_string());
+        return Err("the file does not start with the line 'ply'".to_string().into());
     }
     let mut i = 0;
     let mut enc = None;
@@ -328,7 +328,7 @@ fn header(b: &[u8]) -> std::result::Result<(Encoding, Vec<Element>, usize), Stri
                     "ascii" => Encoding::Ascii,
                     "binary_little_endian" => Encoding::Little,
                     "binary_big_endian" => Encoding::Big,
-                    _ => return Err(format!("line {n}: unknown format '{f}'")),
+                    _ => return Err(format!("line {n}: unknown format '{f}'").into()),
                 })
             }
             ["element", name, count] => {
@@ -338,12 +338,12 @@ fn header(b: &[u8]) -> std::result::Result<(Encoding, Vec<Element>, usize), Stri
             ["property", "list", ct, it, name] => {
                 let el = elements.last_mut().ok_or(format!("line {n}: property before any element"))?;
                 let (Some(ct), Some(it)) = (Ty::parse(ct), Ty::parse(it)) else {
-                    return Err(format!("line {n}: unknown property type in '{line}'"));
+                    return Err(format!("line {n}: unknown property type in '{line}'").into());
                 };
                 // Items may be floats (MeshLab's per-corner `texcoord`); face indices are checked
                 // where the face list is chosen.
                 if matches!(ct, Ty::F32 | Ty::F64) {
-                    return Err(format!("line {n}: a list's count must be an integer in '{line}'"));
+                    return Err(format!("line {n}: a list's count must be an integer in '{line}'").into());
                 }
                 el.props.push(Property { name: name.to_string(), ty: it, list: Some(ct) });
             }
@@ -353,7 +353,7 @@ fn header(b: &[u8]) -> std::result::Result<(Encoding, Vec<Element>, usize), Stri
                 el.props.push(Property { name: name.to_string(), ty, list: None });
             }
             ["end_header"] => break,
-            _ => return Err(format!("line {n}: '{line}' is not a header line")),
+            _ => return Err(format!("line {n}: '{line}' is not a header line").into()),
         }
     }
     let enc = enc.ok_or("no 'format' line")?;
