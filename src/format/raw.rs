@@ -115,7 +115,6 @@ fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<RawMesh> 
 pub fn from_scene(scene: &Scene) -> Result<RawMesh> {
     let mut out = RawMesh::default();
     let meshes = scene.json.get("meshes").and_then(|m| m.as_array()).map_or(0, |m| m.len());
-    let nodes = scene.json.get("nodes").and_then(|n| n.as_array());
     let mut with_normals = true;
     for inst in instances(scene) {
         if inst.mesh >= meshes {
@@ -124,8 +123,8 @@ pub fn from_scene(scene: &Scene) -> Result<RawMesh> {
         let Some(mesh_json) = scene.array("meshes").get(inst.mesh) else { continue };
         let name = inst
             .node
-            .and_then(|n| nodes.and_then(|a| a.get(n)).and_then(|n| n.get("name")).and_then(|s| s.as_str()))
-            .or_else(|| mesh_json.get("name").and_then(|s| s.as_str()))
+            .and_then(|n| scene.node_name(n))
+            .or_else(|| scene.mesh_name(inst.mesh))
             .map_or_else(|| format!("mesh {}", inst.mesh), str::to_string);
         let place = inst.placement();
         let prims = mesh_json.get("primitives").and_then(|p| p.as_array()).map_or(0, |p| p.len());

@@ -60,6 +60,18 @@ impl Instance {
     }
 }
 
+impl Scene {
+    /// Node `n`'s name, if it has one: the one reading of names the reports use.
+    pub fn node_name(&self, n: usize) -> Option<&str> {
+        self.array("nodes").get(n)?.get("name")?.as_str()
+    }
+
+    /// Mesh `m`'s name, if it has one.
+    pub fn mesh_name(&self, m: usize) -> Option<&str> {
+        self.array("meshes").get(m)?.get("name")?.as_str()
+    }
+}
+
 /// How geometry is placed in the world by an [`Instance`]: the one place positions, normals,
 /// tangents and winding are moved there (HIGH's reader, LOW for the baker, the preview). What
 /// comes out is not normalised: each caller normalises in the precision it works in.

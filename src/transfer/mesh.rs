@@ -120,21 +120,11 @@ fn dvec(p: [f32; 3]) -> DVec3 {
 }
 
 fn node_name(scene: &Scene, n: usize) -> String {
-    scene
-        .array("nodes")
-        .get(n)
-        .and_then(|n| n.get("name"))
-        .and_then(|s| s.as_str())
-        .map_or_else(|| format!("node {n}"), str::to_string)
+    scene.node_name(n).map_or_else(|| format!("node {n}"), str::to_string)
 }
 
 fn mesh_name(scene: &Scene, m: usize) -> String {
-    scene
-        .array("meshes")
-        .get(m)
-        .and_then(|m| m.get("name"))
-        .and_then(|s| s.as_str())
-        .map_or_else(|| format!("mesh {m}"), str::to_string)
+    scene.mesh_name(m).map_or_else(|| format!("mesh {m}"), str::to_string)
 }
 
 /// Where the primitives `prims` are shown. A mesh shown by two nodes has one UV layout in two

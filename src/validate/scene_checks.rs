@@ -136,7 +136,7 @@ fn check_texcoords(scene: &Scene, mats: &Materials, r: PrimRef, s: &mut Subject)
 }
 
 fn prim_name(scene: &Scene, r: PrimRef) -> String {
-    match scene.json.pointer(&format!("/meshes/{}/name", r.mesh)).and_then(|n| n.as_str()) {
+    match scene.mesh_name(r.mesh) {
         Some(n) if !n.is_empty() => format!("mesh {} ('{n}') primitive {}", r.mesh, r.primitive),
         _ => format!("mesh {} primitive {}", r.mesh, r.primitive),
     }
@@ -222,7 +222,7 @@ fn check_nodes(scene: &Scene) -> Option<Subject> {
     if shown.is_empty() {
         return None;
     }
-    let name = |i: usize| scene.json.pointer(&format!("/nodes/{i}/name")).and_then(|x| x.as_str());
+    let name = |i: usize| scene.node_name(i);
     let mut s = Subject::new("file", "node transforms");
     let mut worst = Worst::default();
     let mirrored: Vec<&(usize, usize, bool)> = shown.iter().filter(|s| s.2).collect();
