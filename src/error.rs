@@ -9,7 +9,13 @@ use std::path::{Path, PathBuf};
 pub enum Error {
     /// The input could not be used: unreadable, malformed or unsupported.
     #[error("{}: {msg}", path.display())]
-    Input { path: PathBuf, msg: String },
+    Input {
+        path: PathBuf,
+        msg: String,
+        /// What a library reported underneath, when a [`Fault`] carried it.
+        #[source]
+        cause: Option<Box<dyn std::error::Error + Send + Sync + 'static>>,
+    },
     /// The command line asks for something impossible.
     #[error("{0}")]
     Usage(String),
@@ -20,7 +26,11 @@ pub enum Error {
 
 impl Error {
     pub fn input(path: impl AsRef<Path>, msg: impl Into<String>) -> Self {
-        Error::Input { path: path.as_ref().to_path_buf(), msg: msg.into() }
+        Error::Input { path: path.as_ref().to_path_buf(), msg: msg.into(), cause: None }
+    }
+    /// A reader's [`Fault`] in the file `path`, its cause kept.
+    pub fn in_file(path: impl AsRef<Path>, fault: Fault) -> Self {
+        Error::Input { path: path.as_ref().to_path_buf(), msg: fault.msg, cause: fault.source }
     }
     pub fn output(path: impl AsRef<Path>, msg: impl std::fmt::Display) -> Self {
         Error::Output { path: path.as_ref().to_path_buf(), msg: msg.to_string() }

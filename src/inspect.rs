@@ -249,7 +249,7 @@ fn image_info(scene: &Scene, i: usize, img: &Value) -> ImageInfo {
                     info.bits_per_channel = Some(h.bits_per_channel);
                     info.variant = h.variant;
                 }
-                Err(e) => info.error = Some(e),
+                Err(e) => info.error = Some(e.to_string()),
             }
         }
         Err(e) => info.error = Some(e.to_string()),

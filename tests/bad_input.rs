@@ -209,7 +209,7 @@ fn truncated_png() -> Vec<u8> {
 fn hostile_png_headers_parse_without_allocating() {
     assert_eq!(crc32(b"IEND"), 0xAE42_6082, "the CRC helper is right");
     let e = bumpbake::format::image::dimensions(&png_claiming(200_000, 200_000)).unwrap_err();
-    assert!(e.contains("200000x200000"), "{e}");
+    assert!(e.to_string().contains("200000x200000"), "{e}");
     assert!(bumpbake::format::image::decode(&png_claiming(200_000, 200_000)).is_err());
     assert!(bumpbake::format::image::decode(&truncated_png()).is_err());
     assert_eq!(bumpbake::format::image::dimensions(&tiny_png()).unwrap(), (1, 1));

@@ -140,7 +140,7 @@ fn check_png_complete(path: &Path) -> Result<()> {
 
 fn check_size(path: &Path, w: u32, h: u32, max_pixels: u64) -> Result<()> {
     crate::format::image::check_size_within(w, h, &crate::format::image::Limits::file(max_pixels))
-        .map_err(|m| Error::input(path, m))
+        .map_err(|m| Error::in_file(path, m))
 }
 
 /// Reads an encoded normal map (RGB or RGBA; 8-bit, 16-bit or float) without decoding texels.

@@ -298,7 +298,7 @@ pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
                 path,
                 format!("neither a mesh (.gltf, .glb, .obj) nor an image bumpbake reads ({})", img::DECODED),
             ),
-            _ => Error::input(path, e),
+            _ => Error::in_file(path, e),
         })?;
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let mut subject = Subject::new("image", name);

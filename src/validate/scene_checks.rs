@@ -289,7 +289,7 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
                 return s;
             }
             let codec = bytes.as_deref().map(normal_image::Codec::sniff).unwrap_or(normal_image::Codec::Lossless);
-            match bytes.and_then(|b| image::decode(&b)) {
+            match bytes.and_then(|b| image::decode(&b).map_err(|e| e.to_string())) {
                 Ok(img) => normal_image::check(&img, codec, Convention::Opengl, &wanted_by, &mut s),
                 Err(e) => s.check(
                     Code::NORMALMAP_UNREADABLE,

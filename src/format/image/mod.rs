@@ -19,6 +19,7 @@
 
 mod ktx2;
 
+use crate::error::{Fault, Faulty};
 use image::{DynamicImage, ImageDecoder, ImageError, ImageFormat, ImageReader};
 use std::io::Cursor;
 
@@ -162,12 +163,12 @@ fn not_decoded(kind: Kind) -> String {
 
 /// One line of plain words for a decoder's error. The `image` crate's own messages name formats
 /// by their Rust names (`Jpeg`, `Some(Png)`), so only the underlying cause is kept.
-fn describe(kind: Kind, e: ImageError) -> String {
+fn describe(kind: Kind, e: ImageError) -> Fault {
     // Some decoders quote their message (a string's debug form); the quotes are not words.
     let one_line = |s: String| s.split_whitespace().collect::<Vec<_>>().join(" ").trim_matches('"').to_string();
     let name = kind.name();
-    match e {
-        ImageError::Decoding(d) => match std::error::Error::source(&d) {
+    let words = match &e {
+        ImageError::Decoding(d) => match std::error::Error::source(d) {
             Some(cause) => format!("cannot decode as {name}: {}", one_line(cause.to_string())),
             None => format!("cannot decode as {name}: the data is malformed"),
         },
@@ -181,7 +182,8 @@ fn describe(kind: Kind, e: ImageError) -> String {
         }
         ImageError::Parameter(p) => format!("cannot decode as {name}: {}", one_line(p.to_string())),
         ImageError::Encoding(_) => format!("cannot decode as {name}"),
-    }
+    };
+    Fault::caused_by(words, e)
 }
 
 /// Why bumpbake will not decode these bytes, when their header says so: a format it does not
@@ -196,7 +198,7 @@ pub fn not_decoded_why(bytes: &[u8]) -> Option<String> {
     }
 }
 
-fn reader<R: std::io::BufRead + std::io::Seek>(head: &[u8], source: R) -> Result<(Kind, ImageReader<R>), String> {
+fn reader<R: std::io::BufRead + std::io::Seek>(head: &[u8], source: R) -> Faulty<(Kind, ImageReader<R>)> {
     let kind = Kind::sniff(head);
     let format = kind.format().ok_or_else(|| not_decoded(kind))?;
     let mut r = ImageReader::new(source);
@@ -213,14 +215,14 @@ fn decoder_limits(l: &Limits) -> image::Limits {
 }
 
 /// The size an image's header claims, checked against the texture limits; nothing is decoded.
-pub fn dimensions(bytes: &[u8]) -> Result<(u32, u32), String> {
+pub fn dimensions(bytes: &[u8]) -> Faulty<(u32, u32)> {
     dimensions_within(bytes, &Limits::TEXTURE)
 }
 
 /// [`dimensions`] under other limits.
-pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Result<(u32, u32), String> {
+pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Faulty<(u32, u32)> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
-        return ktx2::dimensions_within(bytes, limits);
+        return ktx2::dimensions_within(bytes, limits).map_err(Fault::from);
     }
     let (kind, mut r) = reader(bytes, Cursor::new(bytes))?;
     // Only the header is read here; the size checks below give the clearer message.
@@ -248,7 +250,7 @@ pub struct Header {
 
 /// Reads only the header: format, size and sample layout. Nothing is decoded and the size is not
 /// checked against the limits (describing a huge image is fine; decoding it is not).
-pub fn header(bytes: &[u8]) -> Result<Header, String> {
+pub fn header(bytes: &[u8]) -> Faulty<Header> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
         let (width, height, colour, bits_per_channel, variant) = ktx2::describe(bytes)?;
         return Ok(Header { kind: Kind::Ktx2, width, height, colour, bits_per_channel, variant: Some(variant) });
@@ -271,37 +273,40 @@ pub fn header(bytes: &[u8]) -> Result<Header, String> {
 }
 
 /// Refuses empty images and those past the texture limits.
-pub fn check_size(w: u32, h: u32) -> Result<(), String> {
+pub fn check_size(w: u32, h: u32) -> Faulty<()> {
     check_size_within(w, h, &Limits::TEXTURE)
 }
 
-pub fn check_size_within(w: u32, h: u32, l: &Limits) -> Result<(), String> {
+pub fn check_size_within(w: u32, h: u32, l: &Limits) -> Faulty<()> {
     if w == 0 || h == 0 {
-        return Err(format!("image is {w}x{h} pixels (empty)"));
+        return Err(format!("image is {w}x{h} pixels (empty)").into());
     }
     let pixels = w as u64 * h as u64;
     if let (Some(option), true) = (l.option, pixels > l.max_pixels) {
-        return Err(format!("image is {w}x{h} = {pixels} pixels, more than the limit of {} ({option})", l.max_pixels));
+        return Err(
+            format!("image is {w}x{h} = {pixels} pixels, more than the limit of {} ({option})", l.max_pixels).into()
+        );
     }
     if w > l.max_side || h > l.max_side || pixels > l.max_pixels {
         let side = if l.max_side == u32::MAX { String::new() } else { format!("at most {} per side and ", l.max_side) };
         return Err(format!(
             "image claims {w}x{h} = {pixels} pixels, more than bumpbake decodes ({side}{} pixels)",
             l.max_pixels
-        ));
+        )
+        .into());
     }
     Ok(())
 }
 
 /// Decodes a glTF texture after checking its header, under [`Limits::TEXTURE`].
-pub fn decode(bytes: &[u8]) -> Result<DynamicImage, String> {
+pub fn decode(bytes: &[u8]) -> Faulty<DynamicImage> {
     decode_within(bytes, &Limits::TEXTURE)
 }
 
 /// Decodes an image after checking its header against `limits`.
-pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
+pub fn decode_within(bytes: &[u8], limits: &Limits) -> Faulty<DynamicImage> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
-        return ktx2::decode_within(bytes, limits);
+        return ktx2::decode_within(bytes, limits).map_err(Fault::from);
     }
     dimensions_within(bytes, limits)?;
     if Kind::sniff(bytes) == Kind::Jpeg && !jpeg_is_whole(bytes) {
@@ -326,7 +331,7 @@ fn decode_reader<R: std::io::BufRead + std::io::Seek>(
     kind: Kind,
     mut r: ImageReader<R>,
     limits: &Limits,
-) -> Result<DynamicImage, String> {
+) -> Faulty<DynamicImage> {
     r.limits(decoder_limits(limits));
     let decoder = r.into_decoder().map_err(|e| describe(kind, e))?;
     let (w, h) = decoder.dimensions();
@@ -354,10 +359,10 @@ pub fn read_file(path: &std::path::Path, max_pixels: u64) -> crate::error::Resul
         // Whole in memory: a JPEG to check its end, a KTX2 to follow its index; both are small
         // beside their pixels.
         let bytes = std::fs::read(path).map_err(open)?;
-        return decode_within(&bytes, &limits).map_err(|m| Error::input(path, m));
+        return decode_within(&bytes, &limits).map_err(|m| Error::in_file(path, m));
     }
-    let (kind, r) = reader(&head, file).map_err(|m| Error::input(path, m))?;
-    decode_reader(kind, r, &limits).map_err(|m| Error::input(path, m))
+    let (kind, r) = reader(&head, file).map_err(|m| Error::in_file(path, m))?;
+    decode_reader(kind, r, &limits).map_err(|m| Error::in_file(path, m))
 }
 
 /// Whether the file starts like a PNG (read from its first bytes only).
@@ -457,20 +462,21 @@ mod tests {
 
     #[test]
     fn sizes_past_the_limits_are_refused_before_decoding() {
-        assert!(check_size(200_000, 200_000).unwrap_err().contains("200000x200000"));
+        assert!(check_size(200_000, 200_000).unwrap_err().to_string().contains("200000x200000"));
         assert!(check_size(MAX_SIDE + 1, 1).is_err());
         assert!(check_size(0, 5).is_err());
         assert!(check_size(MAX_SIDE, MAX_SIDE).is_err(), "too many pixels in all");
         assert!(check_size(8192, 8192).is_ok());
         assert!(check_size_within(100, 100, &Limits::file(9_999))
             .unwrap_err()
+            .to_string()
             .contains("limit of 9999 (--max-pixels)"));
     }
 
     #[test]
     fn garbage_is_not_an_image() {
         assert!(decode(b"").is_err());
-        assert!(decode(b"hello world, not an image").unwrap_err().contains("PNG, JPEG, WebP"));
+        assert!(decode(b"hello world, not an image").unwrap_err().to_string().contains("PNG, JPEG, WebP"));
         assert!(decode(b"\x89PNG\r\n\x1a\n").is_err());
     }
 
@@ -496,20 +502,23 @@ mod tests {
     fn formats_not_decoded_and_broken_files_are_named_in_words() {
         let ktx2 = [0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB, 0x0D, 0x0A, 0x1A, 0x0A, 0, 0, 0, 0];
         let e = decode(&ktx2).unwrap_err();
-        assert!(e.starts_with("cannot decode as KTX2: the file ends early"), "{e}");
+        assert!(e.to_string().starts_with("cannot decode as KTX2: the file ends early"), "{e}");
         let e = decode(b"GIF89a\x01\x00\x01\x00").unwrap_err();
-        assert!(e.starts_with("a GIF image"), "{e}");
+        assert!(e.to_string().starts_with("a GIF image"), "{e}");
         let jpeg = encoded(ImageFormat::Jpeg);
         // Cut anywhere in its scan, a JPEG still "decodes" (the rest grey): it must be refused.
         for cut in [jpeg.len() / 3, jpeg.len() - 2] {
             let e = decode(&jpeg[..cut]).unwrap_err();
-            assert!(e.starts_with("cannot decode as JPEG"), "{e}");
+            assert!(e.to_string().starts_with("cannot decode as JPEG"), "{e}");
         }
         let webp = encoded(ImageFormat::WebP);
         let e = decode(&webp[..webp.len() - 10]).unwrap_err();
-        assert!(e.starts_with("cannot decode as WebP"), "{e}");
+        assert!(e.to_string().starts_with("cannot decode as WebP"), "{e}");
         for e in [decode(&jpeg[..40]).unwrap_err(), decode(&webp[..20]).unwrap_err()] {
-            assert!(!e.contains("Some(") && !e.contains("Jpeg") && !e.contains("WebP)"), "{e}");
+            let words = e.to_string();
+            assert!(!words.contains("Some(") && !words.contains("Jpeg") && !words.contains("WebP)"), "{e}");
+            // The decoder's own error stays reachable underneath the words.
+            assert!(std::error::Error::source(&e).is_some(), "{e}");
         }
     }
 }

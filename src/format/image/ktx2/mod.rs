@@ -239,7 +239,7 @@ fn parse(bytes: &[u8]) -> Result<Parsed<'_>, String> {
 /// The size a KTX2 header claims, checked against `limits`; nothing is decoded.
 pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Result<(u32, u32), String> {
     let p = parse(bytes)?;
-    check_size_within(p.width, p.height, limits)?;
+    check_size_within(p.width, p.height, limits).map_err(|f| f.to_string())?;
     Ok((p.width, p.height))
 }
 
@@ -298,7 +298,7 @@ pub fn not_decoded(bytes: &[u8]) -> Option<String> {
 pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
     let p = parse(bytes)?;
     let (w, h) = (p.width, p.height);
-    check_size_within(w, h, limits)?;
+    check_size_within(w, h, limits).map_err(|f| f.to_string())?;
     let level = p.reader.levels().next().ok_or("cannot decode as KTX2: it has no mip level")?;
     let rgba = match p.payload {
         Payload::Etc1s => basis::etc1s(&p.reader, level.data, w, h)?,
