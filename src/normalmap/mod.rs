@@ -21,6 +21,7 @@ mod encode;
 mod filter;
 mod height;
 mod io;
+pub mod mips;
 mod relief;
 mod rows;
 mod spectral;
