@@ -10,7 +10,7 @@ pub mod draco;
 mod gltf_read;
 mod gltf_write;
 pub mod image;
-mod ktx2;
+pub mod ktx2;
 mod meshopt;
 mod obj;
 mod obj_block;

@@ -23,6 +23,9 @@
 //! holds, and every malformed file is one line of words.
 
 mod basis;
+mod write;
+
+pub use write::{encode, Codec, Level};
 
 use super::image::{check_size_within, Limits};
 use image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgba};
@@ -297,11 +300,27 @@ pub fn not_decoded(bytes: &[u8]) -> Option<String> {
 /// Decodes the base level of a KTX2 image, after checking its size against `limits`.
 pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
     let p = parse(bytes)?;
-    let (w, h) = (p.width, p.height);
-    check_size_within(w, h, limits)?;
+    check_size_within(p.width, p.height, limits)?;
     let level = p.reader.levels().next().ok_or("cannot decode as KTX2: it has no mip level")?;
+    decode_level(&p, 0, level)
+}
+
+/// Decodes every mip level of a KTX2 image (level 0 first, sized as KTX2 sizes them), after
+/// checking the base size against `limits`.
+pub fn decode_levels_within(bytes: &[u8], limits: &Limits) -> Result<Vec<DynamicImage>, String> {
+    let p = parse(bytes)?;
+    check_size_within(p.width, p.height, limits)?;
+    let levels: Vec<_> = p.reader.levels().collect();
+    if levels.is_empty() {
+        return Err("cannot decode as KTX2: it has no mip level".into());
+    }
+    levels.into_iter().enumerate().map(|(k, level)| decode_level(&p, k, level)).collect()
+}
+
+fn decode_level(p: &Parsed, k: usize, level: ::ktx2::Level) -> Result<DynamicImage, String> {
+    let (w, h) = ((p.width >> k).max(1), (p.height >> k).max(1));
     let rgba = match p.payload {
-        Payload::Etc1s => basis::etc1s(&p.reader, level.data, w, h)?,
+        Payload::Etc1s => basis::etc1s(&p.reader, k, level.data, w, h)?,
         Payload::Uastc => {
             let blocks = (w as usize).div_ceil(4) * (h as usize).div_ceil(4) * 16;
             let data = unpack(level.data, level.uncompressed_byte_length, blocks, p.supercompression)?;
