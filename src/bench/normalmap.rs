@@ -310,11 +310,12 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
         options: opts,
         encode: ENC8,
         png,
+        ktx2: crate::format::ktx2::Codec::Uastc { level: nm::DEFAULT_UASTC_LEVEL },
     };
     let mut stage_runs: Vec<(f64, Vec<(String, f64)>)> = Vec::new();
     let command_ms = median_ms(runs, || {
         let s = Instant::now();
-        let (t, _) = nm::convert_file(&convert, None).expect("converts");
+        let (t, _, _) = nm::convert_file(&convert, None).expect("converts");
         stage_runs.push((s.elapsed().as_secs_f64(), t.stages));
     });
     stage_runs.sort_by(|a, b| a.0.total_cmp(&b.0));

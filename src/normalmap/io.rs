@@ -1,6 +1,7 @@
 //! Files in and out. Inputs are refused on their header's size before any pixel buffer is
 //! allocated; outputs are written whole or not at all ([`crate::output::write_atomic`]).
 
+use super::ktx2::LevelError;
 use super::{encode_normals, height_from_image, Channel, Depth, EncodeOptions, HeightPlane, NormalData, NormalImage};
 use super::{Convention, NormalPlane, Options, Progress};
 use crate::error::{Error, Result};
@@ -189,6 +190,8 @@ pub enum OutputFormat {
     Png,
     Tiff,
     Exr,
+    /// Basis Universal in KTX2, with a full mip chain.
+    Ktx2,
 }
 
 impl OutputFormat {
@@ -198,9 +201,11 @@ impl OutputFormat {
             "png" => Ok(OutputFormat::Png),
             "tif" | "tiff" => Ok(OutputFormat::Tiff),
             "exr" => Ok(OutputFormat::Exr),
-            _ => {
-                Err(Error::usage(format!("{}: unsupported output format: name it .png, .tif or .exr", path.display())))
-            }
+            "ktx2" => Ok(OutputFormat::Ktx2),
+            _ => Err(Error::usage(format!(
+                "{}: unsupported output format: name it .png, .tif, .exr or .ktx2",
+                path.display()
+            ))),
         }
     }
     /// The sample depth for `--bits` (None: the format's default).
@@ -210,6 +215,10 @@ impl OutputFormat {
             (OutputFormat::Exr, Some(_)) => {
                 Err(Error::usage(format!("{}: EXR output is 32-bit float; --bits is for PNG and TIFF", path.display())))
             }
+            (OutputFormat::Ktx2, Some(16)) => Err(Error::usage(format!(
+                "{}: KTX2 output is 8-bit Basis Universal; --bits 16 is for PNG and TIFF",
+                path.display()
+            ))),
             (_, None | Some(8)) => Ok(Depth::Bits8),
             (_, Some(16)) => Ok(Depth::Bits16),
             (_, Some(b)) => Err(Error::usage(format!("--bits {b}: use 8 or 16"))),
@@ -287,6 +296,7 @@ pub fn image_bytes(img: &NormalImage, format: OutputFormat, png: PngSettings) ->
             Ok(c.into_inner())
         }
         (OutputFormat::Exr, _) => Err("EXR output takes float normals".into()),
+        (OutputFormat::Ktx2, _) => Err("KTX2 output is written with its mip chain by `convert_file`".into()),
         (OutputFormat::Tiff, NormalData::F32(_)) => Err("float TIFF output is not supported: use .exr".into()),
     }
 }
@@ -309,21 +319,41 @@ pub struct Convert {
     /// `depth` is taken from the output name and `--bits` by the caller.
     pub encode: EncodeOptions,
     pub png: PngSettings,
+    /// The codec of KTX2 output.
+    pub ktx2: crate::format::ktx2::Codec,
 }
 
 /// Runs [`Convert`]: decode, filter + encode, serialise, write. Returns the stage timings
-/// (`decode`, `filter`, `encode`, `write`, in ms). Nothing is written unless all succeeds.
+/// (`decode`, `filter`, `encode`, `write`, in ms; KTX2 adds `mips` and `check`), the flatness
+/// warning, and for KTX2 each level's error. Nothing is written unless all succeeds.
 ///
 /// PNG output is streamed: strips of rows are filtered (in parallel) into one reused buffer and
 /// handed to the compressor, so the encoded map never exists whole and memory stays at about
 /// the height plane plus the compressed file.
-pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<String>)> {
+pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<String>, Option<Vec<LevelError>>)> {
     let format = OutputFormat::from_path(&c.output)?;
     let mut t = Timings::default();
     let height = t.time("decode", || load_height(&c.input, c.channel, c.max_pixels))?;
     // Judged on the texels as written, as `validate` judges them.
     let mut flat = super::Flatness::default();
-    let bytes = if format == OutputFormat::Png && c.encode.depth != Depth::Float {
+    let mut levels = None;
+    let bytes = if format == OutputFormat::Ktx2 {
+        if c.encode.alpha_height || c.encode.depth != Depth::Bits8 {
+            return Err(Error::usage(format!(
+                "{}: KTX2 output is an 8-bit RGB normal map (no --alpha, no --bits 16)",
+                c.output.display()
+            )));
+        }
+        let img = t.time("filter", || encode_normals(&height, &c.options, &c.encode, progress));
+        flat = super::Flatness::of_image(&img);
+        let NormalData::U8(rgb) = &img.data else {
+            return Err(Error::output(&c.output, "KTX2 output takes 8-bit normals"));
+        };
+        let (bytes, report) = super::ktx2::ktx2_bytes(rgb, img.width, img.height, c.ktx2, &mut t)
+            .map_err(|m| Error::output(&c.output, m))?;
+        levels = Some(report);
+        bytes
+    } else if format == OutputFormat::Png && c.encode.depth != Depth::Float {
         let (bytes, filter_ms, encode_ms) = png_streamed(&height, &c.options, &c.encode, c.png, progress, &mut flat)
             .map_err(|m| Error::output(&c.output, m))?;
         t.stages.push(("filter".into(), filter_ms));
@@ -337,7 +367,7 @@ pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<
     let warning = flat.warning(&height, c.options.strength, 1.0);
     drop(height);
     t.time("write", || crate::output::write_atomic(&c.output, &bytes))?;
-    Ok((t, warning))
+    Ok((t, warning, levels))
 }
 
 /// Strip-by-strip filtering and PNG compression; returns the bytes and the time spent in
