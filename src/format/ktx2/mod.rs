@@ -5,8 +5,9 @@
 //! What is decoded: Basis Universal (ETC1S with BasisLZ, UASTC with or without Zstandard),
 //! transcoded to RGBA8 (`basis.rs`), and the plain formats a normal, height or colour map uses
 //! (8-bit R/RG/RGB/RGBA, UNORM and SRGB; 16-bit UNORM R/RG/RGB/RGBA; float16/32 R and RGBA)
-//! with no, Zstandard or zlib supercompression. Only the base mip level of a 2D texture is read:
-//! it is the one a texture check or a bake works on. Block-compressed formats (BC*, ETC2, ASTC)
+//! with no, Zstandard or zlib supercompression. Only the base mip level of a 2D texture is read
+//! by the commands: it is the one a texture check or a bake works on ([`decode_levels_within`]
+//! reads them all, for checking what `write.rs` wrote). Block-compressed formats (BC*, ETC2, ASTC)
 //! and arrays, cube maps and volumes are named and refused; a glTF texture with a fallback source
 //! then falls back to it.
 //!
