@@ -203,4 +203,12 @@ fn bad_ktx2_options_are_one_line_and_exit_2() {
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
         assert!(!k.exists(), "{args:?} left a file");
     }
+    // Wider than the Basis Universal encoder takes.
+    let wide = tmp(&d, "wide.png");
+    image::ImageBuffer::from_pixel(16385, 1, image::Luma([9u8])).save(&wide).unwrap();
+    let out = run(&["normalmap", p(&wide), "-o", p(&k)], None);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("16384") && err.trim_end().lines().count() == 1, "{err}");
+    assert!(!k.exists());
 }

@@ -344,6 +344,15 @@ pub fn convert_file(c: &Convert, progress: Progress) -> Result<(Timings, Option<
                 c.output.display()
             )));
         }
+        let max = crate::format::ktx2::MAX_SIDE as usize;
+        if height.width > max || height.height > max {
+            return Err(Error::usage(format!(
+                "{}: a {}x{} map is larger than Basis Universal encodes ({max} texels a side): write PNG",
+                c.output.display(),
+                height.width,
+                height.height
+            )));
+        }
         let img = t.time("filter", || encode_normals(&height, &c.options, &c.encode, progress));
         flat = super::Flatness::of_image(&img);
         let NormalData::U8(rgb) = &img.data else {

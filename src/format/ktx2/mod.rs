@@ -26,7 +26,7 @@
 mod basis;
 mod write;
 
-pub use write::{encode, Codec, Level};
+pub use write::{encode, Codec, Level, MAX_SIDE};
 
 use super::image::{check_size_within, Limits};
 use image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgba};

@@ -27,6 +27,9 @@ pub struct Level<'a> {
     pub rgb: &'a [u8],
 }
 
+/// The largest side the Basis Universal encoder takes (`BASISU_MAX_SUPPORTED_TEXTURE_DIMENSION`).
+pub const MAX_SIDE: u32 = 16384;
+
 const HEADER: usize = 77;
 const SLICE: usize = 23;
 const BASIS_LZ: u32 = 1;
@@ -137,6 +140,12 @@ fn kvd() -> Vec<u8> {
 /// A KTX2 file of `levels` (level 0 first, each half the one before as KTX2 sizes them).
 /// `threads`: the encoder's; the bytes do not depend on it.
 pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> Result<Vec<u8>, String> {
+    if let Some(l) = levels.first().filter(|l| l.width > MAX_SIDE || l.height > MAX_SIDE) {
+        return Err(format!(
+            "a {}x{} map is larger than Basis Universal encodes ({MAX_SIDE} texels a side)",
+            l.width, l.height
+        ));
+    }
     for l in levels {
         if l.width == 0 || l.height == 0 || l.rgb.len() != l.width as usize * l.height as usize * 3 {
             return Err(format!("a {}x{} level with {} bytes of RGB", l.width, l.height, l.rgb.len()));
