@@ -163,6 +163,7 @@ fn normalmap_reports_its_rows() {
                 ..Default::default()
             },
             png: Default::default(),
+            ktx2: bumpbake::format::image::ktx2::Codec::Uastc { level: nm::DEFAULT_UASTC_LEVEL },
         };
         nm::convert_file(&c, &progress).unwrap();
     }

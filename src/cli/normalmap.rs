@@ -3,6 +3,7 @@
 
 use super::args::{ChannelArg, ConventionArg, FilterArg, WrapArg};
 use bumpbake::batch;
+use bumpbake::format::image::ktx2::Codec;
 use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, Converted, EncodeOptions, Filter, Options, Wrap};
 use bumpbake::progress::Reporter;
 use bumpbake::{Error, Result};
@@ -16,21 +17,50 @@ pub enum Alpha {
     Height,
 }
 
+/// The Basis Universal codec of KTX2 output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Ktx2Codec {
+    Uastc,
+    Etc1s,
+}
+
+fn codec(args: &Args) -> Result<Codec> {
+    match (args.ktx2, args.ktx2_quality) {
+        (Ktx2Codec::Uastc, q) => match q.unwrap_or(nm::DEFAULT_UASTC_LEVEL) {
+            level @ 0..=4 => Ok(Codec::Uastc { level }),
+            q => Err(Error::usage(format!("--ktx2-quality {q}: UASTC levels are 0 to 4"))),
+        },
+        (Ktx2Codec::Etc1s, q) => match q.unwrap_or(nm::DEFAULT_ETC1S_QUALITY) {
+            quality @ 1..=255 => Ok(Codec::Etc1s { quality }),
+            q => Err(Error::usage(format!("--ktx2-quality {q}: ETC1S quality is 1 to 255"))),
+        },
+    }
+}
+
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Examples:
   bumpbake normalmap bricks_height.png -o bricks_normal.png --strength 4
   bumpbake normalmap terrain16.png -o terrain_n.png --bits 16 --height-range 0.05 --texel-size 0.001 --wrap repeat
-  bumpbake normalmap depth.exr -o n.png --invert --convention directx --alpha height --filter spectral")]
+  bumpbake normalmap depth.exr -o n.png --invert --convention directx --alpha height --filter spectral
+  bumpbake normalmap bricks_height.png -o bricks_normal.ktx2 --strength 4 --ktx2 uastc --ktx2-quality 3")]
 pub struct Args {
     /// Height maps: PNG (8/16-bit gray, gray+alpha, RGB, RGBA), JPEG, WebP, TIFF or EXR.
     #[arg(required = true)]
     pub heights: Vec<PathBuf>,
-    /// Normal map to write (one input): .png (8 or 16-bit), .tif, or .exr (32-bit float).
+    /// Normal map to write (one input): .png (8 or 16-bit), .tif, .exr (32-bit float), or .ktx2
+    /// (Basis Universal with a mip chain built from the full-resolution normals).
     #[arg(short, long, value_name = "NORMAL", conflicts_with = "out_dir")]
     pub output: Option<PathBuf>,
     /// Extension of the outputs written into --out-dir.
-    #[arg(long, value_parser = ["png", "tif", "exr"], default_value = "png")]
+    #[arg(long, value_parser = ["png", "tif", "exr", "ktx2"], default_value = "png")]
     pub out_ext: String,
+    /// Basis Universal codec of .ktx2 outputs: uastc (Zstandard-supercompressed, higher quality)
+    /// or etc1s (BasisLZ, smaller).
+    #[arg(long, value_enum, default_value_t = Ktx2Codec::Uastc)]
+    pub ktx2: Ktx2Codec,
+    /// KTX2 quality: UASTC pack level 0-4 [default: 2], ETC1S quality 1-255 [default: 128].
+    #[arg(long, value_name = "Q")]
+    pub ktx2_quality: Option<u32>,
     /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
     #[arg(long, value_enum, default_value_t = ChannelArg::from(Channel::default()))]
     pub channel: ChannelArg,
@@ -97,6 +127,7 @@ fn strength(args: &Args) -> Result<f32> {
 
 pub fn run(args: Args) -> Result<u8> {
     let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
+    let ktx2 = codec(&args)?;
     let options =
         Options { strength: strength(&args)?, filter: args.filter.into(), wrap: args.wrap.into(), invert: args.invert };
     let convert = |input: &Path, output: &Path| -> Result<Convert> {
@@ -113,6 +144,7 @@ pub fn run(args: Args) -> Result<u8> {
                 alpha_height: args.alpha == Some(Alpha::Height),
             },
             png: nm::PngSettings::default(),
+            ktx2,
         })
     };
     let results = if args.heights.len() == 1 {

@@ -1,6 +1,7 @@
 //! Files in and out. Inputs are refused on their header's size before any pixel buffer is
 //! allocated; outputs are written whole or not at all ([`crate::output::write_atomic`]).
 
+use super::ktx2::LevelError;
 use super::{encode_normals, height_from_image, Channel, Depth, EncodeOptions, HeightPlane, NormalData, NormalImage};
 use super::{Convention, NormalPlane, Options};
 use crate::error::{Error, Result};
@@ -190,6 +191,8 @@ pub enum OutputFormat {
     Png,
     Tiff,
     Exr,
+    /// Basis Universal in KTX2, with a full mip chain.
+    Ktx2,
 }
 
 impl OutputFormat {
@@ -199,9 +202,11 @@ impl OutputFormat {
             "png" => Ok(OutputFormat::Png),
             "tif" | "tiff" => Ok(OutputFormat::Tiff),
             "exr" => Ok(OutputFormat::Exr),
-            _ => {
-                Err(Error::usage(format!("{}: unsupported output format: name it .png, .tif or .exr", path.display())))
-            }
+            "ktx2" => Ok(OutputFormat::Ktx2),
+            _ => Err(Error::usage(format!(
+                "{}: unsupported output format: name it .png, .tif, .exr or .ktx2",
+                path.display()
+            ))),
         }
     }
     /// The sample depth for `--bits` (None: the format's default).
@@ -211,6 +216,10 @@ impl OutputFormat {
             (OutputFormat::Exr, Some(_)) => {
                 Err(Error::usage(format!("{}: EXR output is 32-bit float; --bits is for PNG and TIFF", path.display())))
             }
+            (OutputFormat::Ktx2, Some(16)) => Err(Error::usage(format!(
+                "{}: KTX2 output is 8-bit Basis Universal; --bits 16 is for PNG and TIFF",
+                path.display()
+            ))),
             (_, None | Some(8)) => Ok(Depth::Bits8),
             (_, Some(16)) => Ok(Depth::Bits16),
             (_, Some(b)) => Err(Error::usage(format!("--bits {b}: use 8 or 16"))),
@@ -288,6 +297,7 @@ pub fn image_bytes(img: &NormalImage, format: OutputFormat, png: PngSettings) ->
             Ok(c.into_inner())
         }
         (OutputFormat::Exr, _) => Err("EXR output takes float normals".into()),
+        (OutputFormat::Ktx2, _) => Err("KTX2 output is written with its mip chain by `convert_file`".into()),
         (OutputFormat::Tiff, NormalData::F32(_)) => Err("float TIFF output is not supported: use .exr".into()),
     }
 }
@@ -310,6 +320,8 @@ pub struct Convert {
     /// `depth` is taken from the output name and `--bits` by the caller.
     pub encode: EncodeOptions,
     pub png: PngSettings,
+    /// The codec of KTX2 output.
+    pub ktx2: crate::format::image::ktx2::Codec,
 }
 
 /// What one conversion did (`--json`: `docs/json.md`, normalmap).
@@ -321,13 +333,17 @@ pub struct Converted {
     pub timings_ms: Timings,
     /// A map that came out (nearly) flat.
     pub warnings: Vec<String>,
+    /// KTX2 output: each mip level's angular error after the codec.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub levels: Option<Vec<LevelError>>,
     /// Whether this is one of several inputs (the text then names the files); the caller sets it.
     #[serde(skip)]
     pub batch: bool,
 }
 
-/// Runs [`Convert`]: decode, filter + encode, serialise, write. Nothing is written unless all
-/// succeeds. The filter's rows are a stage of `progress`, named after the input.
+/// Runs [`Convert`]: decode, filter + encode, serialise, write (KTX2 adds the `mips` and `check`
+/// stages and each level's error). Nothing is written unless all succeeds. The filter's rows are
+/// a stage of `progress`, named after the input.
 ///
 /// PNG output is streamed: strips of rows are filtered (in parallel) into one reused buffer and
 /// handed to the compressor, so the encoded map never exists whole and memory stays at about
@@ -341,7 +357,7 @@ pub fn convert_file(c: &Convert, progress: &Reporter) -> Result<Converted> {
     progress.start(&format!("normalmap {}", c.input.display()), height.height as u64, "rows");
     let bytes = filtered_bytes(c, format, &height, progress, &mut t, &mut flat);
     progress.finish();
-    let bytes = bytes?;
+    let (bytes, levels) = bytes?;
     let warning = flat.warning(&height, c.options.strength, 1.0);
     drop(height);
     t.time("write", || crate::output::write_atomic(&c.output, &bytes))?;
@@ -350,11 +366,13 @@ pub fn convert_file(c: &Convert, progress: &Reporter) -> Result<Converted> {
         output: c.output.clone(),
         timings_ms: t,
         warnings: warning.into_iter().collect(),
+        levels,
         batch: false,
     })
 }
 
-/// The encoded file's bytes: filtered and encoded, timed as `filter` and `encode`.
+/// The encoded file's bytes: filtered and encoded, timed as `filter` and `encode` (KTX2: with
+/// each level's error).
 fn filtered_bytes(
     c: &Convert,
     format: OutputFormat,
@@ -362,17 +380,42 @@ fn filtered_bytes(
     progress: &Reporter,
     t: &mut Timings,
     flat: &mut super::Flatness,
-) -> Result<Vec<u8>> {
-    if format == OutputFormat::Png && c.encode.depth != Depth::Float {
+) -> Result<(Vec<u8>, Option<Vec<LevelError>>)> {
+    if format == OutputFormat::Ktx2 {
+        if c.encode.alpha_height || c.encode.depth != Depth::Bits8 {
+            return Err(Error::usage(format!(
+                "{}: KTX2 output is an 8-bit RGB normal map (no --alpha, no --bits 16)",
+                c.output.display()
+            )));
+        }
+        let max = crate::format::image::ktx2::MAX_SIDE as usize;
+        if height.width > max || height.height > max {
+            return Err(Error::usage(format!(
+                "{}: a {}x{} map is larger than Basis Universal encodes ({max} texels a side): write PNG",
+                c.output.display(),
+                height.width,
+                height.height
+            )));
+        }
+        let img = t.time("filter", || encode_normals(height, &c.options, &c.encode, progress));
+        *flat = super::Flatness::of_image(&img);
+        let NormalData::U8(rgb) = &img.data else {
+            return Err(Error::output(&c.output, "KTX2 output takes 8-bit normals"));
+        };
+        let (bytes, report) =
+            super::ktx2::ktx2_bytes(rgb, img.width, img.height, c.ktx2, t).map_err(|m| Error::output(&c.output, m))?;
+        Ok((bytes, Some(report)))
+    } else if format == OutputFormat::Png && c.encode.depth != Depth::Float {
         let (bytes, filter_ms, encode_ms) = png_streamed(height, &c.options, &c.encode, c.png, progress, flat)
             .map_err(|m| Error::output(&c.output, m))?;
         t.stages.push(("filter".into(), filter_ms));
         t.stages.push(("encode".into(), encode_ms));
-        Ok(bytes)
+        Ok((bytes, None))
     } else {
         let img = t.time("filter", || encode_normals(height, &c.options, &c.encode, progress));
         *flat = super::Flatness::of_image(&img);
-        t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))
+        let bytes = t.time("encode", || image_bytes(&img, format, c.png)).map_err(|m| Error::output(&c.output, m))?;
+        Ok((bytes, None))
     }
 }
 

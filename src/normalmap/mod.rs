@@ -14,6 +14,7 @@
 //! - [`encode_normals`]: filter + encode in one pass; [`encode_plane`] for float normals.
 //! - [`write_normal_image`], [`png_bytes`]: files; [`decode_normal_image`]: back to vectors.
 //! - [`convert_file`]: the whole `bumpbake normalmap` command.
+//! - [`mips::build`], [`ktx2_bytes`]: mip chains from the full-resolution normals, and KTX2.
 //! - [`Flatness`]: the largest tilt of a map's texels, the one rule for "(nearly) flat" that `bake`,
 //!   `normalmap` and `validate` share.
 
@@ -21,6 +22,8 @@ mod encode;
 mod filter;
 mod height;
 mod io;
+mod ktx2;
+pub mod mips;
 mod relief;
 mod rows;
 mod spectral;
@@ -35,6 +38,7 @@ pub use io::{
     colour_words, convert_file, decode_normal_image, image_bytes, load_height, load_normal_image, open_image,
     png_bytes, write_normal_image, Convert, Converted, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
+pub use ktx2::{ktx2_bytes, LevelError, DEFAULT_ETC1S_QUALITY, DEFAULT_UASTC_LEVEL};
 pub use relief::{steepest_slope, Flatness, Verdict, EXACT_FLAT_DEG, NEARLY_FLAT_DEG};
 pub use rows::unit_normal;
 

@@ -360,6 +360,7 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
         options: opts,
         encode: ENC8,
         png,
+        ktx2: bumpbake::format::image::ktx2::Codec::Uastc { level: nm::DEFAULT_UASTC_LEVEL },
     };
     let mut stage_runs: Vec<(f64, Vec<(String, f64)>)> = Vec::new();
     let command_ms = median_ms(runs, || {

@@ -292,14 +292,27 @@ impl Human for Inspection {
     }
 }
 
-/// One height map converted: named only in a batch (one map converted says nothing), and any
-/// warning.
+/// One height map converted: named only in a batch (one map converted says nothing), any
+/// warning, and for KTX2 each level's error.
 impl Human for Converted {
     fn human(&self) -> String {
         let mut s =
             if self.batch { format!("{} -> {}\n", self.input.display(), self.output.display()) } else { String::new() };
         for w in &self.warnings {
             s += &format!("bumpbake: warning: {}: {w}\n", self.input.display());
+        }
+        if let Some(levels) = &self.levels {
+            s += &format!(
+                "{}: {} mip levels; angle of the stored texels to the averaged full-resolution normals:\n",
+                self.output.display(),
+                levels.len()
+            );
+            for l in levels {
+                s += &format!(
+                    "  level {:>2} {:>5}x{:<5} mean {:.2}°  p99 {:.2}°  mean length {:.4}\n",
+                    l.level, l.width, l.height, l.mean_deg, l.p99_deg, l.mean_length
+                );
+            }
         }
         s
     }

@@ -17,7 +17,7 @@
 //! Commands that only carry images along (`tangents` copies or embeds them byte for byte) never
 //! decode them at all.
 
-mod ktx2;
+pub mod ktx2;
 
 use crate::error::{Fault, Faulty};
 use image::{DynamicImage, ImageDecoder, ImageError, ImageFormat, ImageReader};

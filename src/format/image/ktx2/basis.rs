@@ -165,9 +165,15 @@ fn u32_at(b: &[u8], at: usize) -> usize {
     u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]) as usize
 }
 
-/// ETC1S/BasisLZ: the codebooks and tables from the supercompression global data, the base
-/// level's RGB (and alpha) slice from its level data, to RGBA8.
-pub(super) fn etc1s(reader: &::ktx2::Reader<&[u8]>, level: &[u8], w: u32, h: u32) -> Result<Vec<u8>, String> {
+/// ETC1S/BasisLZ: the codebooks and tables from the supercompression global data, level
+/// `index`'s RGB (and alpha) slice from its level data, to RGBA8.
+pub(super) fn etc1s(
+    reader: &::ktx2::Reader<&[u8]>,
+    index: usize,
+    level: &[u8],
+    w: u32,
+    h: u32,
+) -> Result<Vec<u8>, String> {
     let sgd = reader.supercompression_global_data();
     // endpointCount u16, selectorCount u16, then endpoints/selectors/tables/extended byte lengths.
     const FIXED: usize = 20;
@@ -190,8 +196,11 @@ pub(super) fn etc1s(reader: &::ktx2::Reader<&[u8]>, level: &[u8], w: u32, h: u32
         selector_data: &sgd[data_start + e..data_start + e + s],
         tables: &sgd[data_start + e + s..data_start + e + s + t],
     };
-    // The base level's image descriptor is the first: flags, rgb offset/length, alpha offset/length.
-    let d = FIXED;
+    // One image descriptor per level, level 0 first: flags, rgb offset/length, alpha offset/length.
+    if index >= images {
+        return Err(broken("a level without an image descriptor"));
+    }
+    let d = FIXED + index * IMAGE_DESC;
     let slice_of = |ofs: usize, len: usize| -> Result<&[u8], String> {
         ofs.checked_add(len).and_then(|end| level.get(ofs..end)).ok_or_else(|| broken("a slice lies outside its level"))
     };

@@ -5,8 +5,9 @@
 //! What is decoded: Basis Universal (ETC1S with BasisLZ, UASTC with or without Zstandard),
 //! transcoded to RGBA8 (`basis.rs`), and the plain formats a normal, height or colour map uses
 //! (8-bit R/RG/RGB/RGBA, UNORM and SRGB; 16-bit UNORM R/RG/RGB/RGBA; float16/32 R and RGBA)
-//! with no, Zstandard or zlib supercompression. Only the base mip level of a 2D texture is read:
-//! it is the one a texture check or a bake works on. Block-compressed formats (BC*, ETC2, ASTC)
+//! with no, Zstandard or zlib supercompression. Only the base mip level of a 2D texture is read
+//! by the commands: it is the one a texture check or a bake works on ([`decode_levels_within`]
+//! reads them all, for checking what `write.rs` wrote). Block-compressed formats (BC*, ETC2, ASTC)
 //! and arrays, cube maps and volumes are named and refused; a glTF texture with a fallback source
 //! then falls back to it.
 //!
@@ -23,6 +24,9 @@
 //! holds, and every malformed file is one line of words.
 
 mod basis;
+mod write;
+
+pub use write::{encode, Codec, Level, MAX_SIDE};
 
 use super::{check_size_within, Limits};
 use image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgba};
@@ -297,11 +301,27 @@ pub fn not_decoded(bytes: &[u8]) -> Option<String> {
 /// Decodes the base level of a KTX2 image, after checking its size against `limits`.
 pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
     let p = parse(bytes)?;
-    let (w, h) = (p.width, p.height);
-    check_size_within(w, h, limits).map_err(|f| f.to_string())?;
+    check_size_within(p.width, p.height, limits).map_err(|f| f.to_string())?;
     let level = p.reader.levels().next().ok_or("cannot decode as KTX2: it has no mip level")?;
+    decode_level(&p, 0, level)
+}
+
+/// Decodes every mip level of a KTX2 image (level 0 first, sized as KTX2 sizes them), after
+/// checking the base size against `limits`.
+pub fn decode_levels_within(bytes: &[u8], limits: &Limits) -> Result<Vec<DynamicImage>, String> {
+    let p = parse(bytes)?;
+    check_size_within(p.width, p.height, limits).map_err(|f| f.to_string())?;
+    let levels: Vec<_> = p.reader.levels().collect();
+    if levels.is_empty() {
+        return Err("cannot decode as KTX2: it has no mip level".into());
+    }
+    levels.into_iter().enumerate().map(|(k, level)| decode_level(&p, k, level)).collect()
+}
+
+fn decode_level(p: &Parsed, k: usize, level: ::ktx2::Level) -> Result<DynamicImage, String> {
+    let (w, h) = ((p.width >> k).max(1), (p.height >> k).max(1));
     let rgba = match p.payload {
-        Payload::Etc1s => basis::etc1s(&p.reader, level.data, w, h)?,
+        Payload::Etc1s => basis::etc1s(&p.reader, k, level.data, w, h)?,
         Payload::Uastc => {
             let blocks = (w as usize).div_ceil(4) * (h as usize).div_ceil(4) * 16;
             let data = unpack(level.data, level.uncompressed_byte_length, blocks, p.supercompression)?;

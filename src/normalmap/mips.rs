@@ -1,0 +1,239 @@
+//! Mip chains built from the full-resolution normals.
+//!
+//! Averaging encoded texels level by level compounds the 8-bit rounding at every step and loses
+//! how much the normals under a texel disagree. Here every level-k texel is the area-weighted
+//! mean of the level-0 unit normals its footprint covers, so its direction is the ideal one and
+//! its length `L` (below 1 where the normals spread) is kept for specular antialiasing
+//! (`variance = (1 - L) / L`, Toksvig).
+//!
+//! Level sizes follow KTX2: `max(1, floor(w / 2^k))`. When that does not divide the source size
+//! evenly, a texel's footprint covers the source proportionally: `w / w_k` source texels, the
+//! edge ones by the fraction that lies inside.
+
+use super::encode::{decode8, quantize8};
+use rayon::prelude::*;
+
+/// One level: the stored texels and what they were made from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MipLevel {
+    pub width: usize,
+    pub height: usize,
+    /// RGB8, row-major from the top row, in the convention of the level-0 bytes.
+    pub rgb: Vec<u8>,
+    /// The renormalised average of each texel (what `rgb` rounds).
+    pub ideal: Vec<[f32; 3]>,
+    /// The length of each texel's average before renormalising: 1 where its footprint is flat.
+    pub mean_length: Vec<f32>,
+}
+
+/// How many levels a full chain of a `w` x `h` map has: `floor(log2(max(w, h))) + 1`.
+pub fn level_count(w: usize, h: usize) -> usize {
+    let m = w.max(h).max(1);
+    (usize::BITS - m.leading_zeros()) as usize
+}
+
+/// `max(1, floor(n / 2^k))`.
+pub fn level_size(n: usize, k: usize) -> usize {
+    (n >> k.min(usize::BITS as usize - 1)).max(1)
+}
+
+/// The source texels (index, weight) each destination texel covers along one axis. Weights sum
+/// to `n / m` for every destination texel; integer arithmetic in units of `1/m` keeps the
+/// footprints exact, so the result does not depend on rounding of the boundaries.
+fn footprints(n: usize, m: usize) -> Vec<Vec<(usize, f64)>> {
+    (0..m)
+        .map(|d| {
+            // The footprint is [d·n/m, (d+1)·n/m); in units of 1/m: [d·n, (d+1)·n).
+            let (lo, hi) = (d * n, (d + 1) * n);
+            let first = lo / m;
+            let last = (hi - 1) / m;
+            (first..=last)
+                .map(|i| {
+                    let a = lo.max(i * m);
+                    let b = hi.min((i + 1) * m);
+                    (i, (b - a) as f64 / m as f64)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// One texel as built: its bytes, its ideal direction, its mean length.
+type Texel = ([u8; 3], [f32; 3], f32);
+
+/// The 8-bit texel of a unit vector: rounding, `+Z` for a zero average.
+fn encode(v: [f64; 3]) -> ([u8; 3], [f32; 3], f64) {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let n = if len > 1e-12 { [v[0] / len, v[1] / len, v[2] / len] } else { [0.0, 0.0, 1.0] };
+    let n32 = [n[0] as f32, n[1] as f32, n[2] as f32];
+    ([quantize8(n32[0]), quantize8(n32[1]), quantize8(n32[2])], n32, len)
+}
+
+/// Unit normals of RGB8 texels (`2c/255 - 1`, renormalised; `+Z` for a zero vector).
+pub fn unit_normals(rgb: &[u8]) -> Vec<[f32; 3]> {
+    rgb.chunks_exact(3)
+        .map(|t| {
+            let v = [decode8(t[0]), decode8(t[1]), decode8(t[2])];
+            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if len > 1e-12 {
+                [v[0] / len, v[1] / len, v[2] / len]
+            } else {
+                [0.0, 0.0, 1.0]
+            }
+        })
+        .collect()
+}
+
+/// Every level of the chain of a `w` x `h` map of unit normals (level 0 first). Level 0 is the
+/// input itself, encoded. Each texel is computed on its own in a fixed order, so the bytes do not
+/// depend on the number of threads.
+pub fn build(normals: &[[f32; 3]], w: usize, h: usize) -> Vec<MipLevel> {
+    assert_eq!(normals.len(), w * h, "a plane of w x h normals");
+    (0..level_count(w, h))
+        .map(|k| {
+            let (lw, lh) = (level_size(w, k), level_size(h, k));
+            let fx = footprints(w, lw);
+            let fy = footprints(h, lh);
+            let area = (w as f64 / lw as f64) * (h as f64 / lh as f64);
+            let rows: Vec<Vec<Texel>> = (0..lh)
+                .into_par_iter()
+                .map(|y| {
+                    (0..lw)
+                        .map(|x| {
+                            let mut s = [0.0f64; 3];
+                            for &(sy, wy) in &fy[y] {
+                                let row = &normals[sy * w..(sy + 1) * w];
+                                for &(sx, wx) in &fx[x] {
+                                    let n = row[sx];
+                                    let wt = wx * wy;
+                                    s[0] += wt * n[0] as f64;
+                                    s[1] += wt * n[1] as f64;
+                                    s[2] += wt * n[2] as f64;
+                                }
+                            }
+                            let mean = [s[0] / area, s[1] / area, s[2] / area];
+                            let (rgb, ideal, len) = encode(mean);
+                            (rgb, ideal, len.min(1.0) as f32)
+                        })
+                        .collect()
+                })
+                .collect();
+            let mut level = MipLevel {
+                width: lw,
+                height: lh,
+                rgb: Vec::with_capacity(lw * lh * 3),
+                ideal: Vec::with_capacity(lw * lh),
+                mean_length: Vec::with_capacity(lw * lh),
+            };
+            for (rgb, ideal, len) in rows.into_iter().flatten() {
+                level.rgb.extend_from_slice(&rgb);
+                level.ideal.push(ideal);
+                level.mean_length.push(len);
+            }
+            level
+        })
+        .collect()
+}
+
+/// Angles (degrees) between stored RGB8 texels and the ideal normals: mean and 99th percentile.
+pub fn angular_error(rgb: &[u8], ideal: &[[f32; 3]]) -> (f64, f64) {
+    let mut deg: Vec<f64> = unit_normals(rgb)
+        .iter()
+        .zip(ideal)
+        .map(|(a, b)| {
+            let d = a[0] as f64 * b[0] as f64 + a[1] as f64 * b[1] as f64 + a[2] as f64 * b[2] as f64;
+            d.clamp(-1.0, 1.0).acos().to_degrees()
+        })
+        .collect();
+    if deg.is_empty() {
+        return (0.0, 0.0);
+    }
+    let mean = deg.iter().sum::<f64>() / deg.len() as f64;
+    deg.sort_by(f64::total_cmp);
+    let p99 = deg[((deg.len() as f64 * 0.99).ceil() as usize).clamp(1, deg.len()) - 1];
+    (mean, p99)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn level_sizes_follow_ktx2() {
+        assert_eq!(level_count(256, 256), 9);
+        assert_eq!(level_count(300, 17), 9);
+        assert_eq!(level_count(1, 1), 1);
+        assert_eq!((level_size(300, 3), level_size(17, 3)), (37, 2));
+        assert_eq!(level_size(17, 8), 1);
+    }
+
+    #[test]
+    fn footprints_cover_the_source_proportionally() {
+        for (n, m) in [(8, 4), (5, 2), (17, 8), (3, 1), (7, 3)] {
+            let f = footprints(n, m);
+            let mut covered = vec![0.0; n];
+            for d in &f {
+                let sum: f64 = d.iter().map(|&(_, w)| w).sum();
+                assert!((sum - n as f64 / m as f64).abs() < 1e-12);
+                for &(i, w) in d {
+                    covered[i] += w;
+                }
+            }
+            assert!(covered.iter().all(|&c| (c - 1.0).abs() < 1e-12), "{n}->{m}: {covered:?}");
+        }
+    }
+
+    /// A checkerboard of two normals tilted by ±t about y averages to +Z with length cos(t).
+    #[test]
+    fn checkerboard_of_tilts_averages_to_z_with_length_cos() {
+        let t = 30f32.to_radians();
+        let (a, b) = ([t.sin(), 0.0, t.cos()], [-t.sin(), 0.0, t.cos()]);
+        let (w, h) = (16, 16);
+        let n: Vec<[f32; 3]> = (0..w * h).map(|i| if (i % w + i / w) % 2 == 0 { a } else { b }).collect();
+        let levels = build(&n, w, h);
+        assert_eq!(levels.len(), 5);
+        for l in &levels[1..] {
+            for (&len, ideal) in l.mean_length.iter().zip(&l.ideal) {
+                assert!((len - t.cos()).abs() < 1e-6, "{len}");
+                assert!(ideal[0].abs() < 1e-6 && ideal[1].abs() < 1e-6 && (ideal[2] - 1.0).abs() < 1e-6);
+            }
+            assert!(l.rgb.chunks_exact(3).all(|c| c == [128, 128, 255]));
+        }
+        assert!(levels[0].mean_length.iter().all(|&l| (l - 1.0).abs() < 1e-6));
+    }
+
+    /// Opposite normals cancel: the texel is +Z by rule, with length 0.
+    #[test]
+    fn a_zero_average_is_plus_z() {
+        let n = vec![[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]];
+        let levels = build(&n, 2, 1);
+        assert_eq!(levels[1].rgb, vec![128, 128, 255]);
+        assert_eq!(levels[1].mean_length, vec![0.0]);
+    }
+
+    #[test]
+    fn odd_sizes_cover_every_source_texel() {
+        // Level 1 of a 3-wide map is floor(3/2) = 1 texel covering all three.
+        let t = [[0.6f32, 0.0, 0.8], [0.0, 0.0, 1.0], [0.0, 0.6, 0.8]];
+        let levels = build(&t, 3, 1);
+        assert_eq!(levels.len(), 2);
+        let m: [f64; 3] = [0.6 / 3.0, 0.6 / 3.0, 2.6 / 3.0];
+        let len: f64 = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+        assert!((levels[1].mean_length[0] as f64 - len).abs() < 1e-6);
+    }
+
+    #[test]
+    fn same_bytes_on_one_thread() {
+        let n: Vec<[f32; 3]> = (0..37 * 23)
+            .map(|i| {
+                let a = i as f32 * 0.37;
+                let v = [a.sin() * 0.5, a.cos() * 0.4, 1.0f32];
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                [v[0] / l, v[1] / l, v[2] / l]
+            })
+            .collect();
+        let many = build(&n, 37, 23);
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| build(&n, 37, 23));
+        assert_eq!(many, one);
+    }
+}
