@@ -52,7 +52,7 @@ pub(crate) enum Pick {
 }
 
 /// Which sample of a `channels`-sample pixel holds the height, or why none does.
-pub(crate) fn pick(channel: Channel, channels: usize, has_alpha: bool, is_colour: bool) -> Result<Pick, String> {
+pub(crate) fn pick(channel: Channel, channels: usize, has_alpha: bool, is_colour: bool) -> crate::error::Faulty<Pick> {
     Ok(match channel {
         Channel::A if !has_alpha => return Err("--channel a, but the image has no alpha channel".into()),
         Channel::A => Pick::Index(channels - 1),
@@ -88,7 +88,7 @@ pub(crate) fn convert_row_be16(raw: &[u8], ch: usize, pick: Pick, out: &mut [f32
 }
 
 /// Turns a decoded image into heights. The error says what is wrong, without the file name.
-pub fn height_from_image(img: &DynamicImage, channel: Channel) -> Result<HeightPlane, String> {
+pub fn height_from_image(img: &DynamicImage, channel: Channel) -> crate::error::Faulty<HeightPlane> {
     let (w, h) = (img.width() as usize, img.height() as usize);
     let has_alpha = img.color().has_alpha();
     let channels = img.color().channel_count() as usize;
@@ -119,9 +119,9 @@ pub fn height_from_image(img: &DynamicImage, channel: Channel) -> Result<HeightP
 }
 
 /// Float inputs may hold NaN or infinities, which no filter can differentiate.
-pub(crate) fn check_finite(data: &[f32], w: usize) -> Result<(), String> {
+pub(crate) fn check_finite(data: &[f32], w: usize) -> crate::error::Faulty<()> {
     match data.iter().position(|v| !v.is_finite()) {
-        Some(i) => Err(format!("height sample at column {}, row {} is {}", i % w, i / w, data[i])),
+        Some(i) => Err(format!("height sample at column {}, row {} is {}", i % w, i / w, data[i]).into()),
         None => Ok(()),
     }
 }
@@ -158,13 +158,13 @@ mod tests {
         assert_eq!(height_from_image(&img, Channel::G).unwrap().data[0], 0.0);
         assert_eq!(height_from_image(&img, Channel::A).unwrap().data[0], 0.2);
         let gray = DynamicImage::ImageLuma8(GrayImage::new(1, 1));
-        assert!(height_from_image(&gray, Channel::A).unwrap_err().contains("no alpha"));
+        assert!(height_from_image(&gray, Channel::A).unwrap_err().to_string().contains("no alpha"));
     }
 
     #[test]
     fn non_finite_floats_are_refused() {
         let img = image::Rgb32FImage::from_raw(2, 1, vec![0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0]).unwrap();
-        let e = height_from_image(&DynamicImage::ImageRgb32F(img), Channel::R).unwrap_err();
+        let e = height_from_image(&DynamicImage::ImageRgb32F(img), Channel::R).unwrap_err().to_string();
         assert!(e.contains("column 1, row 0"), "{e}");
     }
 }

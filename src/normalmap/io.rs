@@ -34,7 +34,7 @@ pub fn load_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Hei
         }
     }
     let img = open_image(path, max_pixels)?;
-    height_from_image(&img, channel).map_err(|m| Error::input(path, m))
+    height_from_image(&img, channel).map_err(|m| Error::in_file(path, m))
 }
 
 /// PNG rows straight into the height plane, as they are inflated: no decoded image in between
@@ -57,7 +57,7 @@ fn load_png_height(path: &Path, channel: Channel, max_pixels: u64) -> Result<Opt
     let ch = color.samples();
     let has_alpha = matches!(color, png::ColorType::GrayscaleAlpha | png::ColorType::Rgba);
     let is_colour = matches!(color, png::ColorType::Rgb | png::ColorType::Rgba);
-    let pick = super::height::pick(channel, ch, has_alpha, is_colour).map_err(|m| Error::input(path, m))?;
+    let pick = super::height::pick(channel, ch, has_alpha, is_colour).map_err(|m| Error::in_file(path, m))?;
     let (w, h) = (w as usize, h as usize);
     let mut data = vec![0.0f32; w * h];
     // Inflating is sequential; converting rows to heights is not. One thread inflates batches of
@@ -242,7 +242,7 @@ impl Default for PngSettings {
 }
 
 /// PNG bytes of a normal map (8- or 16-bit RGB/RGBA). Float maps cannot be PNG.
-pub fn png_bytes(img: &NormalImage, settings: PngSettings) -> std::result::Result<Vec<u8>, String> {
+pub fn png_bytes(img: &NormalImage, settings: PngSettings) -> crate::error::Faulty<Vec<u8>> {
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, img.width as u32, img.height as u32);
     enc.set_color(if img.channels == 4 { png::ColorType::Rgba } else { png::ColorType::Rgb });
@@ -271,7 +271,7 @@ pub fn png_bytes(img: &NormalImage, settings: PngSettings) -> std::result::Resul
 }
 
 /// The bytes of a normal map in `format` (PNG, TIFF or EXR; EXR takes float maps only).
-pub fn image_bytes(img: &NormalImage, format: OutputFormat, png: PngSettings) -> std::result::Result<Vec<u8>, String> {
+pub fn image_bytes(img: &NormalImage, format: OutputFormat, png: PngSettings) -> crate::error::Faulty<Vec<u8>> {
     let (w, h) = (img.width as u32, img.height as u32);
     let rgba = img.channels == 4;
     match (format, &img.data) {
@@ -428,7 +428,7 @@ fn png_streamed(
     settings: PngSettings,
     progress: &Reporter,
     flat: &mut super::Flatness,
-) -> std::result::Result<(Vec<u8>, f64, f64), String> {
+) -> crate::error::Faulty<(Vec<u8>, f64, f64)> {
     use std::io::Write;
     use std::time::Instant;
     let (w, h) = (height.width, height.height);
@@ -458,7 +458,7 @@ fn png_streamed(
         for (k, _) in starts.iter().enumerate() {
             std::mem::swap(&mut strips.u8s, &mut done_u8);
             std::mem::swap(&mut strips.u16s, &mut done_u16);
-            let mut write = || -> std::result::Result<f64, String> {
+            let mut write = || -> crate::error::Faulty<f64> {
                 let t = Instant::now();
                 if sample_bytes == 2 {
                     flat.push_u16(&done_u16, ch);

@@ -36,7 +36,7 @@ pub fn ktx2_bytes(
     h: usize,
     codec: Codec,
     t: &mut Timings,
-) -> Result<(Vec<u8>, Vec<LevelError>), String> {
+) -> crate::error::Faulty<(Vec<u8>, Vec<LevelError>)> {
     let levels: Vec<MipLevel> = t.time("mips", || mips::build(&mips::unit_normals(rgb), w, h));
     let input: Vec<Level> =
         levels.iter().map(|l| Level { width: l.width as u32, height: l.height as u32, rgb: &l.rgb }).collect();
@@ -47,10 +47,12 @@ pub fn ktx2_bytes(
 }
 
 /// Every level of `bytes` transcoded and compared with `levels`' ideal normals.
-pub fn measure(bytes: &[u8], levels: &[MipLevel]) -> Result<Vec<LevelError>, String> {
+pub fn measure(bytes: &[u8], levels: &[MipLevel]) -> crate::error::Faulty<Vec<LevelError>> {
     let stored = ktx2::decode_levels_within(bytes, &Limits::file(u64::MAX))?;
     if stored.len() != levels.len() {
-        return Err(format!("the KTX2 written holds {} levels where {} were encoded", stored.len(), levels.len()));
+        return Err(
+            format!("the KTX2 written holds {} levels where {} were encoded", stored.len(), levels.len()).into()
+        );
     }
     Ok(stored
         .iter()

@@ -70,7 +70,8 @@ pub(super) fn encode(
         NormalImage { width: w, height: h, channels: 3, data }
     };
     let depth = if s.sixteen_bit { Depth::Bits16 } else { Depth::Bits8 };
-    let png = normalmap::png_bytes(&img(depth, false), PngSettings::default()).map_err(Error::usage)?;
+    let png =
+        normalmap::png_bytes(&img(depth, false), PngSettings::default()).map_err(|e| Error::usage(e.to_string()))?;
     let mut files = Vec::new();
     if let Some(p) = &s.map_out {
         let format = normalmap::OutputFormat::from_path(p)?;

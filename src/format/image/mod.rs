@@ -222,7 +222,7 @@ pub fn dimensions(bytes: &[u8]) -> Faulty<(u32, u32)> {
 /// [`dimensions`] under other limits.
 pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Faulty<(u32, u32)> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
-        return ktx2::dimensions_within(bytes, limits).map_err(Fault::from);
+        return ktx2::dimensions_within(bytes, limits);
     }
     let (kind, mut r) = reader(bytes, Cursor::new(bytes))?;
     // Only the header is read here; the size checks below give the clearer message.
@@ -306,7 +306,7 @@ pub fn decode(bytes: &[u8]) -> Faulty<DynamicImage> {
 /// Decodes an image after checking its header against `limits`.
 pub fn decode_within(bytes: &[u8], limits: &Limits) -> Faulty<DynamicImage> {
     if Kind::sniff(bytes) == Kind::Ktx2 {
-        return ktx2::decode_within(bytes, limits).map_err(Fault::from);
+        return ktx2::decode_within(bytes, limits);
     }
     dimensions_within(bytes, limits)?;
     if Kind::sniff(bytes) == Kind::Jpeg && !jpeg_is_whole(bytes) {

@@ -37,9 +37,9 @@ struct Slice<'a> {
 struct Out(Vec<u8>);
 
 impl Out {
-    fn put(&mut self, v: u64, n: usize) -> Result<(), String> {
+    fn put(&mut self, v: u64, n: usize) -> crate::error::Faulty<()> {
         if n < 8 && v >> (8 * n) != 0 {
-            return Err(broken("a length too large for a .basis field"));
+            return Err(broken("a length too large for a .basis field").into());
         }
         self.0.extend_from_slice(&v.to_le_bytes()[..n]);
         Ok(())
@@ -57,11 +57,12 @@ struct Codebooks<'a> {
 }
 
 /// A one-image, one-level `.basis` file.
-fn basis_file(etc1s: bool, w: u32, h: u32, cb: &Codebooks, slices: &[Slice]) -> Result<Vec<u8>, String> {
+fn basis_file(etc1s: bool, w: u32, h: u32, cb: &Codebooks, slices: &[Slice]) -> crate::error::Faulty<Vec<u8>> {
     if w > u16::MAX as u32 || h > u16::MAX as u32 {
         return Err(format!(
             "a KTX2 Basis Universal image of {w}x{h} pixels, wider or taller than the transcoder reads (65535)"
-        ));
+        )
+        .into());
     }
     let descs = HEADER + SLICE * slices.len();
     let endpoint_ofs = descs;
@@ -70,7 +71,7 @@ fn basis_file(etc1s: bool, w: u32, h: u32, cb: &Codebooks, slices: &[Slice]) -> 
     let mut slice_ofs = tables_ofs + cb.tables.len();
     let total = slice_ofs + slices.iter().map(|s| s.data.len()).sum::<usize>();
     if total > u32::MAX as usize {
-        return Err(broken("more than 4 GB of data"));
+        return Err(broken("more than 4 GB of data").into());
     }
     let mut o = Out(Vec::with_capacity(total));
     let (flags, format) = match (etc1s, slices.len() == 2) {
@@ -127,10 +128,10 @@ fn basis_file(etc1s: bool, w: u32, h: u32, cb: &Codebooks, slices: &[Slice]) -> 
     Ok(o.0)
 }
 
-fn transcode(file: &[u8], w: u32, h: u32) -> Result<Vec<u8>, String> {
+fn transcode(file: &[u8], w: u32, h: u32) -> crate::error::Faulty<Vec<u8>> {
     let mut t = Transcoder::new();
     if !t.validate_header(file) {
-        return Err(broken("its header does not describe its data"));
+        return Err(broken("its header does not describe its data").into());
     }
     t.prepare_transcoding(file).map_err(|_| broken("its codebooks or tables do not decode"))?;
     let params = TranscodeParameters {
@@ -146,14 +147,14 @@ fn transcode(file: &[u8], w: u32, h: u32) -> Result<Vec<u8>, String> {
     t.end_transcoding();
     let want = w as usize * h as usize * 4;
     if out.len() < want {
-        return Err(broken("the transcoder returned fewer pixels than the image has"));
+        return Err(broken("the transcoder returned fewer pixels than the image has").into());
     }
     Ok(out[..want].to_vec())
 }
 
 /// UASTC blocks (already out of any Zstandard) to RGBA8. `alpha`: the file's alpha channel
 /// carries data (RGBA, or a two-channel map's y).
-pub(super) fn uastc(blocks: &[u8], w: u32, h: u32, alpha: bool) -> Result<Vec<u8>, String> {
+pub(super) fn uastc(blocks: &[u8], w: u32, h: u32, alpha: bool) -> crate::error::Faulty<Vec<u8>> {
     let file = basis_file(false, w, h, &Codebooks::default(), &[Slice { alpha, data: blocks }])?;
     transcode(&file, w, h)
 }
@@ -173,19 +174,19 @@ pub(super) fn etc1s(
     level: &[u8],
     w: u32,
     h: u32,
-) -> Result<Vec<u8>, String> {
+) -> crate::error::Faulty<Vec<u8>> {
     let sgd = reader.supercompression_global_data();
     // endpointCount u16, selectorCount u16, then endpoints/selectors/tables/extended byte lengths.
     const FIXED: usize = 20;
     const IMAGE_DESC: usize = 20;
     if sgd.len() < FIXED {
-        return Err(broken("its global data is shorter than its header"));
+        return Err(broken("its global data is shorter than its header").into());
     }
     let images = reader.header().level_count.max(1) as usize;
     let lengths = [u32_at(sgd, 4), u32_at(sgd, 8), u32_at(sgd, 12), u32_at(sgd, 16)];
     let want = lengths.iter().try_fold(FIXED + images * IMAGE_DESC, |a, &l| a.checked_add(l));
     if want != Some(sgd.len()) {
-        return Err(broken("its global data's lengths do not add up to its size"));
+        return Err(broken("its global data's lengths do not add up to its size").into());
     }
     let data_start = FIXED + images * IMAGE_DESC;
     let (e, s, t) = (lengths[0], lengths[1], lengths[2]);
@@ -198,11 +199,13 @@ pub(super) fn etc1s(
     };
     // One image descriptor per level, level 0 first: flags, rgb offset/length, alpha offset/length.
     if index >= images {
-        return Err(broken("a level without an image descriptor"));
+        return Err(broken("a level without an image descriptor").into());
     }
     let d = FIXED + index * IMAGE_DESC;
-    let slice_of = |ofs: usize, len: usize| -> Result<&[u8], String> {
-        ofs.checked_add(len).and_then(|end| level.get(ofs..end)).ok_or_else(|| broken("a slice lies outside its level"))
+    let slice_of = |ofs: usize, len: usize| -> crate::error::Faulty<&[u8]> {
+        ofs.checked_add(len)
+            .and_then(|end| level.get(ofs..end))
+            .ok_or_else(|| broken("a slice lies outside its level").into())
     };
     let rgb = slice_of(u32_at(sgd, d + 4), u32_at(sgd, d + 8))?;
     let alpha_len = u32_at(sgd, d + 16);

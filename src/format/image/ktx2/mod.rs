@@ -152,7 +152,7 @@ const ZLIB: u32 = 3;
 const MODEL_ETC1S: u32 = 163;
 const MODEL_UASTC: u32 = 166;
 
-fn parse(bytes: &[u8]) -> Result<Parsed<'_>, String> {
+fn parse(bytes: &[u8]) -> crate::error::Faulty<Parsed<'_>> {
     let reader = ::ktx2::Reader::new(bytes).map_err(|e| match e {
         ::ktx2::ParseError::UnexpectedEnd => {
             "cannot decode as KTX2: the file ends early or its index points past its end".to_string()
@@ -170,7 +170,8 @@ fn parse(bytes: &[u8]) -> Result<Parsed<'_>, String> {
             } else {
                 "texture array"
             }
-        ));
+        )
+        .into());
     }
     let supercompression = h.supercompression_scheme.map_or(NONE, |s| s.value());
     let model = reader.basic_dfd().and_then(|d| d.color_model).map_or(0, |m| m.value() as u32);
@@ -195,7 +196,7 @@ fn parse(bytes: &[u8]) -> Result<Parsed<'_>, String> {
         None => {
             return Err(format!(
                 "a KTX2 image with no vkFormat and data format model {model}, which bumpbake does not decode (it reads {READS})"
-            ))
+            ).into())
         }
         Some(v) => match plain(v) {
             Some(p) => {
@@ -205,7 +206,7 @@ fn parse(bytes: &[u8]) -> Result<Parsed<'_>, String> {
                         h.type_size,
                         vk_format_name(v),
                         p.sample.bytes()
-                    ));
+                    ).into());
                 }
                 let tc = if p.channels == 2 { TwoChannel::RedGreen } else { TwoChannel::No };
                 (Payload::Plain(p), tc)
@@ -214,7 +215,7 @@ fn parse(bytes: &[u8]) -> Result<Parsed<'_>, String> {
                 return Err(format!(
                     "a KTX2 image in {}, which bumpbake does not decode (it reads {READS})",
                     vk_format_name(v)
-                ))
+                ).into())
             }
         },
     };
@@ -235,21 +236,21 @@ fn parse(bytes: &[u8]) -> Result<Parsed<'_>, String> {
             Payload::Uastc => "UASTC".to_string(),
             Payload::Plain(p) => vk_format_name(p.vk_format),
         };
-        return Err(format!("cannot decode as KTX2: {what} data with supercompression {name} is not valid KTX2"));
+        return Err(format!("cannot decode as KTX2: {what} data with supercompression {name} is not valid KTX2").into());
     }
     Ok(Parsed { width: h.pixel_width, height: h.pixel_height, payload, supercompression, two_channel, reader })
 }
 
 /// The size a KTX2 header claims, checked against `limits`; nothing is decoded.
-pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> Result<(u32, u32), String> {
+pub fn dimensions_within(bytes: &[u8], limits: &Limits) -> crate::error::Faulty<(u32, u32)> {
     let p = parse(bytes)?;
-    check_size_within(p.width, p.height, limits).map_err(|f| f.to_string())?;
+    check_size_within(p.width, p.height, limits)?;
     Ok((p.width, p.height))
 }
 
 /// What the header says: size, `grey`/`RGB`/`RGBA` as decoded, bits per channel as decoded, and
 /// the variant in words (for `inspect`).
-pub fn describe(bytes: &[u8]) -> Result<(u32, u32, &'static str, u16, String), String> {
+pub fn describe(bytes: &[u8]) -> crate::error::Faulty<(u32, u32, &'static str, u16, String)> {
     let p = parse(bytes)?;
     let (colour, bits) = match p.payload {
         Payload::Etc1s | Payload::Uastc if p.two_channel != TwoChannel::No => ("RGB", 8),
@@ -293,24 +294,24 @@ fn variant(p: &Parsed) -> String {
 /// gives the error).
 pub fn not_decoded(bytes: &[u8]) -> Option<String> {
     match parse(bytes) {
-        Err(e) if !e.starts_with("cannot decode") => Some(e),
+        Err(e) if !e.to_string().starts_with("cannot decode") => Some(e.to_string()),
         _ => None,
     }
 }
 
 /// Decodes the base level of a KTX2 image, after checking its size against `limits`.
-pub fn decode_within(bytes: &[u8], limits: &Limits) -> Result<DynamicImage, String> {
+pub fn decode_within(bytes: &[u8], limits: &Limits) -> crate::error::Faulty<DynamicImage> {
     let p = parse(bytes)?;
-    check_size_within(p.width, p.height, limits).map_err(|f| f.to_string())?;
+    check_size_within(p.width, p.height, limits)?;
     let level = p.reader.levels().next().ok_or("cannot decode as KTX2: it has no mip level")?;
     decode_level(&p, 0, level)
 }
 
 /// Decodes every mip level of a KTX2 image (level 0 first, sized as KTX2 sizes them), after
 /// checking the base size against `limits`.
-pub fn decode_levels_within(bytes: &[u8], limits: &Limits) -> Result<Vec<DynamicImage>, String> {
+pub fn decode_levels_within(bytes: &[u8], limits: &Limits) -> crate::error::Faulty<Vec<DynamicImage>> {
     let p = parse(bytes)?;
-    check_size_within(p.width, p.height, limits).map_err(|f| f.to_string())?;
+    check_size_within(p.width, p.height, limits)?;
     let levels: Vec<_> = p.reader.levels().collect();
     if levels.is_empty() {
         return Err("cannot decode as KTX2: it has no mip level".into());
@@ -318,7 +319,7 @@ pub fn decode_levels_within(bytes: &[u8], limits: &Limits) -> Result<Vec<Dynamic
     levels.into_iter().enumerate().map(|(k, level)| decode_level(&p, k, level)).collect()
 }
 
-fn decode_level(p: &Parsed, k: usize, level: ::ktx2::Level) -> Result<DynamicImage, String> {
+fn decode_level(p: &Parsed, k: usize, level: ::ktx2::Level) -> crate::error::Faulty<DynamicImage> {
     let (w, h) = ((p.width >> k).max(1), (p.height >> k).max(1));
     let rgba = match p.payload {
         Payload::Etc1s => basis::etc1s(&p.reader, k, level.data, w, h)?,
@@ -348,7 +349,7 @@ fn decode_level(p: &Parsed, k: usize, level: ::ktx2::Level) -> Result<DynamicIma
 
 /// The base level's bytes, decompressed if need be; exactly `expected` of them. Decompression
 /// stops past `expected` bytes, whatever the stream or the index claims.
-fn unpack(data: &[u8], uncompressed: u64, expected: usize, scheme: u32) -> Result<Vec<u8>, String> {
+fn unpack(data: &[u8], uncompressed: u64, expected: usize, scheme: u32) -> crate::error::Faulty<Vec<u8>> {
     use std::io::Read;
     let out = match scheme {
         NONE => {
@@ -356,7 +357,8 @@ fn unpack(data: &[u8], uncompressed: u64, expected: usize, scheme: u32) -> Resul
                 return Err(format!(
                     "cannot decode as KTX2: its base level holds {} bytes where its size needs {expected}",
                     data.len()
-                ));
+                )
+                .into());
             }
             return Ok(data.to_vec());
         }
@@ -377,7 +379,7 @@ fn unpack(data: &[u8], uncompressed: u64, expected: usize, scheme: u32) -> Resul
         return Err(format!(
             "cannot decode as KTX2: its base level inflates to {} bytes (the index says {uncompressed}) where its size needs {expected}",
             out.len()
-        ));
+        ).into());
     }
     Ok(out)
 }

@@ -47,7 +47,7 @@ fn u32_at(b: &[u8], at: usize) -> usize {
 }
 
 /// The encoder's `.basis` file of `levels` (level 0 first).
-fn basis_file(levels: &[Level], codec: Codec, threads: u32) -> Result<Vec<u8>, String> {
+fn basis_file(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Faulty<Vec<u8>> {
     let mut p = CompressorParams::new();
     match codec {
         Codec::Uastc { level } => {
@@ -92,10 +92,10 @@ fn basis_file(levels: &[Level], codec: Codec, threads: u32) -> Result<Vec<u8>, S
 }
 
 /// The slices of a `.basis` file, by level: (offset, length), checked against the file.
-fn slices(file: &[u8], levels: usize) -> Result<Vec<(usize, usize)>, String> {
+fn slices(file: &[u8], levels: usize) -> crate::error::Faulty<Vec<(usize, usize)>> {
     let bad = || "the Basis Universal encoder wrote a file bumpbake does not understand".to_string();
     if file.len() < HEADER || u24_at(file, 14) != levels {
-        return Err(bad());
+        return Err(bad().into());
     }
     let descs = u32_at(file, 65);
     let mut out = vec![(0, 0); levels];
@@ -104,7 +104,7 @@ fn slices(file: &[u8], levels: usize) -> Result<Vec<(usize, usize)>, String> {
         let desc = file.get(d..d + SLICE).ok_or_else(bad)?;
         let (level, ofs, len) = (desc[3] as usize, u32_at(desc, 13), u32_at(desc, 17));
         if level >= levels || ofs.checked_add(len).is_none_or(|e| e > file.len()) {
-            return Err(bad());
+            return Err(bad().into());
         }
         out[level] = (ofs, len);
     }
@@ -139,16 +139,17 @@ fn kvd() -> Vec<u8> {
 
 /// A KTX2 file of `levels` (level 0 first, each half the one before as KTX2 sizes them).
 /// `threads`: the encoder's; the bytes do not depend on it.
-pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> Result<Vec<u8>, String> {
+pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Faulty<Vec<u8>> {
     if let Some(l) = levels.first().filter(|l| l.width > MAX_SIDE || l.height > MAX_SIDE) {
         return Err(format!(
             "a {}x{} map is larger than Basis Universal encodes ({MAX_SIDE} texels a side)",
             l.width, l.height
-        ));
+        )
+        .into());
     }
     for l in levels {
         if l.width == 0 || l.height == 0 || l.rgb.len() != l.width as usize * l.height as usize * 3 {
-            return Err(format!("a {}x{} level with {} bytes of RGB", l.width, l.height, l.rgb.len()));
+            return Err(format!("a {}x{} level with {} bytes of RGB", l.width, l.height, l.rgb.len()).into());
         }
     }
     let basis = basis_file(levels, codec, threads)?;
