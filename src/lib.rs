@@ -6,7 +6,7 @@
 //! - [`scene`]: the one in-memory model every stage shares: the glTF JSON as read (its shape
 //!   checked once, [`scene::shape`]), buffers, a renderer's view of each primitive, materials,
 //!   node placement.
-//! - [`format`]: every file format read or written into that model: OBJ, PLY, glTF/GLB (meshopt
+//! - [`format`](mod@format): every file format read or written into that model: OBJ, PLY, glTF/GLB (meshopt
 //!   and Draco decoded on reading), images and KTX2.
 //! - [`bake`], [`inspect`]: the `bake` and `inspect` commands.
 //! - [`tangent`]: MikkTSpace tangent frames, fallback frames, vertex split and merge.

@@ -1,6 +1,6 @@
 //! KTX2, the texture container of production glTF (KHR_texture_basisu), read into the same
 //! [`DynamicImage`] every other image format becomes, so that every command that reads pixels
-//! reads KTX2 through [`super::image`].
+//! reads KTX2 through the image reader ([`super`]).
 //!
 //! What is decoded: Basis Universal (ETC1S with BasisLZ, UASTC with or without Zstandard),
 //! transcoded to RGBA8 (`basis.rs`), and the plain formats a normal, height or colour map uses
