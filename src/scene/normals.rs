@@ -178,14 +178,25 @@ pub fn repair_normals(p: &mut super::Primitive) -> NormalRepair {
     let mut r = NormalRepair::default();
     let Some(s) = p.attr("NORMAL") else { return r };
     let float = s.format.component_type == super::accessor::FLOAT;
+    let len = |n: &[f32; 3]| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let unusable = |n: &[f32; 3]| {
+        let l = len(n);
+        !l.is_finite() || l < 1e-12 || !n.iter().all(|c| c.is_finite())
+    };
+    let off_unit = |n: &[f32; 3]| float && (len(n) - 1.0).abs() > NORMAL_UNIT_TOLERANCE;
+    // Read where stored (float normals are borrowed): almost every file needs nothing, and a
+    // copy of a large mesh's normals would only raise every command's peak memory.
+    if !s.as_f32::<3>().iter().any(|n| unusable(n) || off_unit(n)) {
+        return r;
+    }
     let mut values: Vec<[f32; 3]> = s.to_f32();
     let mut bad = Vec::new();
     for (i, n) in values.iter_mut().enumerate() {
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if !len.is_finite() || len < 1e-12 || !n.iter().all(|c| c.is_finite()) {
+        if unusable(n) {
             bad.push(i);
-        } else if float && (len - 1.0).abs() > NORMAL_UNIT_TOLERANCE {
-            *n = [n[0] / len, n[1] / len, n[2] / len];
+        } else if off_unit(n) {
+            let l = len(n);
+            *n = [n[0] / l, n[1] / l, n[2] / l];
             r.renormalised += 1;
         }
     }
