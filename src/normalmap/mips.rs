@@ -135,6 +135,35 @@ pub fn build(normals: &[[f32; 3]], w: usize, h: usize) -> Vec<MipLevel> {
         .collect()
 }
 
+/// Every level of a scalar plane averaged over the same footprints as [`build`]'s texels (level 0
+/// is the plane itself).
+pub fn scalar_levels(plane: &[f32], w: usize, h: usize) -> Vec<Vec<f32>> {
+    assert_eq!(plane.len(), w * h, "a plane of w x h values");
+    (0..level_count(w, h))
+        .map(|k| {
+            let (lw, lh) = (level_size(w, k), level_size(h, k));
+            let fx = footprints(w, lw);
+            let fy = footprints(h, lh);
+            let area = (w as f64 / lw as f64) * (h as f64 / lh as f64);
+            (0..lh)
+                .into_par_iter()
+                .flat_map_iter(|y| {
+                    let (fx, fy, plane) = (&fx, &fy, plane);
+                    (0..lw).map(move |x| {
+                        let mut s = 0.0f64;
+                        for &(sy, wy) in &fy[y] {
+                            for &(sx, wx) in &fx[x] {
+                                s += wx * wy * plane[sy * w + sx] as f64;
+                            }
+                        }
+                        (s / area) as f32
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Angles (degrees) between stored RGB8 texels and the ideal normals: mean and 99th percentile.
 pub fn angular_error(rgb: &[u8], ideal: &[[f32; 3]]) -> (f64, f64) {
     let mut deg: Vec<f64> = unit_normals(rgb)

@@ -27,6 +27,7 @@ pub mod mips;
 mod relief;
 mod rows;
 mod spectral;
+pub mod specular_aa;
 
 pub use encode::{
     decode16, decode8, encode_normals, encode_normals_into, encode_plane, quantize16, quantize8, Depth, EncodeOptions,
