@@ -199,11 +199,11 @@ fn agreement(src: &Level, dst: &Level) -> Agreement {
     let fy = footprints(src.height, dst.height);
     let (mut ab, mut aa, mut bb) = (0.0f64, 0.0f64, 0.0f64);
     let mut angles = Vec::with_capacity(dst.width * dst.height);
-    for y in 0..dst.height {
-        for x in 0..dst.width {
+    for (y, fy) in fy.iter().enumerate() {
+        for (x, fx) in fx.iter().enumerate() {
             let mut m = [0.0f64; 3];
-            for &(sy, wy) in &fy[y] {
-                for &(sx, wx) in &fx[x] {
+            for &(sy, wy) in fy {
+                for &(sx, wx) in fx {
                     let u = src.unit(sx, sy);
                     for i in 0..3 {
                         m[i] += wx * wy * u[i] as f64;

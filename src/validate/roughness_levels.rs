@@ -138,7 +138,9 @@ pub fn check(scene: &Scene, materials: &[&MaterialInfo], levels: &[Level], s: &m
     // most MARGIN: nothing to find, and the level-0 chain need not be built.
     let most_added = |r: f32| (r.powi(4) + specular_aa::DEFAULT_THRESHOLD.powi(2)).sqrt().sqrt() - r;
     let mut checked = 0usize;
-    let mut flagged: Vec<(String, Vec<(usize, usize, usize)>)> = Vec::new();
+    // Per material: its label and its levels under (level, texels under, texels).
+    type Under = (String, Vec<(usize, usize, usize)>);
+    let mut flagged: Vec<Under> = Vec::new();
     for m in materials {
         let Some(r) = roughness_of(scene, m) else { continue };
         checked += levels.len() - 1;
