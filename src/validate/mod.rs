@@ -19,7 +19,9 @@ pub mod conformance;
 pub mod frames;
 pub mod handedness;
 pub mod lossy;
+pub mod mip_levels;
 pub mod normal_image;
+pub mod roughness_levels;
 mod scene_checks;
 
 pub use crate::normalmap::Convention;
@@ -65,7 +67,7 @@ impl Default for Options {
 /// One offending element, so the user can find it in a DCC tool.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Example {
-    /// `vertex`, `triangle`, `corner`, `texel` or `node`.
+    /// `vertex`, `triangle`, `corner`, `texel`, `node` or `level` (a KTX2 mip level).
     pub kind: &'static str,
     pub index: u64,
     /// Texel column and row (row 0 at the top), for `texel`.

@@ -2,9 +2,13 @@
 //! conformance, degenerate triangles), node transforms, and each normal-map image once.
 
 use super::frames::{self, Explained, PrimData, Quant};
-use super::{conformance, handedness, normal_image, Code, Convention, Example, Finding, Options, Subject, Worst};
+use super::{
+    conformance, handedness, mip_levels, normal_image, roughness_levels, Code, Convention, Example, Finding, Options,
+    Subject, Worst,
+};
 use crate::error::Result;
 use crate::format::image;
+use crate::scene::material::{MaterialInfo, Slot};
 use crate::scene::nodes::instances;
 use crate::scene::view::views;
 use crate::scene::{Materials, PrimRef, Scene};
@@ -258,19 +262,24 @@ fn check_nodes(scene: &Scene) -> Option<Subject> {
 /// those of EXT_texture_webp and KHR_texture_basisu (different clients show different ones),
 /// checked once.
 fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
-    let mut users: BTreeMap<usize, (Vec<String>, Option<&'static str>)> = BTreeMap::new();
+    type Users<'a> = (Vec<String>, Option<&'static str>, Vec<&'a MaterialInfo>);
+    let mut users: BTreeMap<usize, Users> = BTreeMap::new();
     for (m, t) in mats.normal_images().into_values().flatten() {
         for ti in scene.texture_images(t.texture) {
             let entry = users.entry(ti.image).or_default();
             if !entry.0.contains(&m.label()) {
                 entry.0.push(m.label());
             }
+            // Clearcoat normals pair with the clearcoat's roughness, not the base layer's.
+            if t.slot == Slot::Normal && !entry.2.iter().any(|x| x.index == m.index) {
+                entry.2.push(m);
+            }
             entry.1 = entry.1.or(ti.extension);
         }
     }
     users
         .into_iter()
-        .map(|(i, (mats, extension))| {
+        .map(|(i, (mats, extension, base_layer))| {
             let img_json = scene.json.pointer(&format!("/images/{i}")).cloned().unwrap_or(Value::Null);
             let label = img_json
                 .get("name")
@@ -289,18 +298,39 @@ fn check_images(scene: &Scene, mats: &Materials) -> Vec<Subject> {
                 return s;
             }
             let codec = bytes.as_deref().map(normal_image::Codec::sniff).unwrap_or(normal_image::Codec::Lossless);
-            match bytes.and_then(|b| image::decode(&b).map_err(|e| e.to_string())) {
-                Ok(img) => normal_image::check(&img, codec, Convention::Opengl, &wanted_by, &mut s),
-                Err(e) => s.check(
-                    Code::NORMALMAP_UNREADABLE,
-                    Some(Finding::new(
-                        Code::NORMALMAP_UNREADABLE,
-                        1,
-                        1,
-                        "images",
-                        format!("normal texture not checked: {e}"),
-                    )),
-                ),
+            let unreadable = |e: String, what: &str| {
+                let f = Finding::new(Code::NORMALMAP_UNREADABLE, 1, 1, "images", format!("{what} not checked: {e}"));
+                Some(f)
+            };
+            let bytes = match bytes {
+                Ok(b) => b,
+                Err(e) => {
+                    s.check(Code::NORMALMAP_UNREADABLE, unreadable(e, "normal texture"));
+                    return s;
+                }
+            };
+            // A KTX2 carries its own chain: every level is decoded (under the same limits), and
+            // level 0 is checked as any other map.
+            let chain = (image::Kind::sniff(&bytes) == image::Kind::Ktx2)
+                .then(|| image::ktx2::decode_levels_within(&bytes, &image::Limits::TEXTURE));
+            match chain {
+                Some(Ok(imgs)) => {
+                    normal_image::check(&imgs[0], codec, Convention::Opengl, &wanted_by, &mut s);
+                    let levels = mip_levels::levels(&imgs);
+                    drop(imgs);
+                    mip_levels::check(&levels, codec, &mut s);
+                    roughness_levels::check(scene, &base_layer, &levels, &mut s);
+                }
+                chain => match image::decode(&bytes) {
+                    Ok(img) => {
+                        normal_image::check(&img, codec, Convention::Opengl, &wanted_by, &mut s);
+                        // Level 0 decodes and a level below it does not.
+                        if let Some(Err(e)) = chain {
+                            s.check(Code::NORMALMAP_UNREADABLE, unreadable(e.to_string(), "mip levels"));
+                        }
+                    }
+                    Err(e) => s.check(Code::NORMALMAP_UNREADABLE, unreadable(e.to_string(), "normal texture")),
+                },
             }
             s
         })

@@ -34,6 +34,13 @@ pub fn validated_dir(test: &str) -> PathBuf {
     fresh(Path::new(env!("CARGO_TARGET_TMPDIR")).join("validated").join(test))
 }
 
+/// A fresh folder for KTX2 files a test writes that are not inside a validated glTF: CI has a
+/// reference decoder (the Basis Universal command-line tool, tests/ktx2_reference.rs) read every
+/// KTX2 here and under `validated/`.
+pub fn ktx2_dir(test: &str) -> PathBuf {
+    fresh(Path::new(env!("CARGO_TARGET_TMPDIR")).join("ktx2").join(test))
+}
+
 /// Records beside `out` (in `OUT.input.json`) the input it was written from, so that CI's
 /// Khronos check (`.ci/validate-gltf.js`) holds `out` to "no issue its input does not have"
 /// instead of "no issue at all". `explained` lists codes bumpbake's report says it could not

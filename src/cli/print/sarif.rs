@@ -51,6 +51,16 @@ fn description(code: Code) -> &'static str {
             "Scattered texels of a lossy-coded normal map off unit length, within the codec's error."
         }
         NORMALMAP_GREEN_FLIPPED => "The normal map's green channel follows the other convention than the one expected.",
+        NORMALMAP_MIPS_MISSING => {
+            "A KTX2 normal map over 256 texels on a side without the mip levels below 256: it aliases when minified."
+        }
+        NORMALMAP_MIPS_NOT_UNIT => {
+            "KTX2 normal-map mip levels whose mean texel length is off 1: filtered without renormalising."
+        }
+        NORMALMAP_MIPS_DIRECTION => "KTX2 normal-map mip levels whose directions do not follow the level above.",
+        ROUGHNESS_MIPS_NOT_WIDENED => {
+            "The material's roughness does not carry the normal variance its KTX2 normal map's mips average away."
+        }
     }
 }
 
