@@ -170,10 +170,10 @@ pub fn ship(scene: &mut Scene, opts: &ShipOptions) -> Result<TexturesReport> {
                 .push(format!("material {m}: its normal texture has no image bumpbake decodes; left as it was"));
             continue;
         };
-        if !encoded.contains_key(&image) {
+        if let std::collections::btree_map::Entry::Vacant(slot) = encoded.entry(image) {
             let e = encode_normal(scene, image, &bytes, opts.codec)?;
             report.ktx2_bytes += e.bytes;
-            encoded.insert(image, e);
+            slot.insert(e);
         }
         let e = &encoded[&image];
         let t = match shipped.get(&n.texture) {
