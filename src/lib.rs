@@ -32,6 +32,7 @@ pub mod preview;
 pub mod progress;
 pub mod scene;
 pub mod tangent;
+pub mod textures;
 pub mod timings;
 pub mod transfer;
 pub mod validate;

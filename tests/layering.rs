@@ -74,7 +74,7 @@ fn layer(module: &str) -> Option<u8> {
         "scene" => 1,
         "format" => 2,
         "tangent" | "normalmap" => 3,
-        "bake" | "transfer" | "validate" | "preview" | "inspect" | "analytic" => 4,
+        "bake" | "transfer" | "validate" | "preview" | "inspect" | "analytic" | "textures" => 4,
         // `crate::{Error, Result}`: the crate root's re-exports of `error`.
         "Error" | "Result" => 0,
         _ => return None,

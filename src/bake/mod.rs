@@ -41,6 +41,8 @@ pub struct BakeJob {
     pub read: ReadOptions,
     pub write: WriteOptions,
     pub depfile: Option<PathBuf>,
+    /// Ship the textures as KTX2 ([`crate::textures::ship`]); `None`: as made (PNG).
+    pub textures: Option<crate::textures::ShipOptions>,
 }
 
 #[derive(Debug, Clone, serde::Serialize)]
@@ -71,6 +73,9 @@ pub struct BakeReport {
     /// What `--from` baking did, when it ran.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub transfer: Option<crate::transfer::TransferReport>,
+    /// What `--textures ktx2` encoded, when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub textures: Option<crate::textures::TexturesReport>,
 }
 
 pub fn run(job: &BakeJob) -> Result<BakeReport> {
@@ -110,6 +115,10 @@ pub fn run_from(job: &BakeJob, high: Vec<crate::format::raw::RawMesh>) -> Result
         _ => None,
     };
     let removed = if job.keep_all { Vec::new() } else { t.time("leave-out", || scene.leave_out(job.bitangents))? };
+    let textures = match &job.textures {
+        Some(o) => Some(t.time("textures", || crate::textures::ship(&mut scene, o))?),
+        None => None,
+    };
     let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &deps));
@@ -130,6 +139,7 @@ pub fn run_from(job: &BakeJob, high: Vec<crate::format::raw::RawMesh>) -> Result
         warnings,
         timings_ms: t,
         transfer: transfer.map(|(r, _)| r),
+        textures,
     })
 }
 

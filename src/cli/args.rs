@@ -2,7 +2,10 @@
 //! and how the batch runs (`print` prints its results).
 
 use bumpbake::batch::{self, BatchOptions};
-use bumpbake::normalmap::{Channel, Convention, Filter, Wrap};
+use bumpbake::format::image::ktx2::Codec;
+use bumpbake::normalmap::specular_aa::DEFAULT_THRESHOLD;
+use bumpbake::normalmap::{self as nm, Channel, Convention, Filter, Wrap};
+use bumpbake::textures::ShipOptions;
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -89,6 +92,109 @@ arg_enum! {
         Opengl => Opengl,
         /// `+Y` down (DirectX, Unreal): `n.y` negated before encoding, nothing else.
         Directx => Directx,
+    }
+}
+
+/// The Basis Universal codec of KTX2 output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Ktx2Codec {
+    /// UASTC under Zstandard: the quality normal maps want.
+    Uastc,
+    /// ETC1S under BasisLZ: smaller, blockier.
+    Etc1s,
+}
+
+/// The format normal maps are written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TexturesArg {
+    /// PNG, the image every glTF client reads.
+    Png,
+    /// KTX2 (Basis Universal) with a mip chain made from the full-resolution normals;
+    /// in glTF through KHR_texture_basisu.
+    Ktx2,
+}
+
+/// The KTX2 codec and its quality, as `normalmap`, `bake` and `textures` take them.
+#[derive(clap::Args, Debug)]
+pub struct Ktx2Args {
+    /// Basis Universal codec of KTX2 normal maps: uastc (Zstandard-supercompressed, higher
+    /// quality) or etc1s (BasisLZ, smaller) [default: uastc].
+    #[arg(long, value_enum)]
+    pub ktx2: Option<Ktx2Codec>,
+    /// KTX2 quality: UASTC pack level 0-4 [default: 2], ETC1S quality 1-255 [default: 128].
+    #[arg(long, value_name = "Q")]
+    pub ktx2_quality: Option<u32>,
+}
+
+impl Ktx2Args {
+    pub fn codec(&self) -> Result<Codec> {
+        match (self.ktx2.unwrap_or(Ktx2Codec::Uastc), self.ktx2_quality) {
+            (Ktx2Codec::Uastc, q) => match q.unwrap_or(nm::DEFAULT_UASTC_LEVEL) {
+                level @ 0..=4 => Ok(Codec::Uastc { level }),
+                q => Err(Error::usage(format!("--ktx2-quality {q}: UASTC levels are 0 to 4"))),
+            },
+            (Ktx2Codec::Etc1s, q) => match q.unwrap_or(nm::DEFAULT_ETC1S_QUALITY) {
+                quality @ 1..=255 => Ok(Codec::Etc1s { quality }),
+                q => Err(Error::usage(format!("--ktx2-quality {q}: ETC1S quality is 1 to 255"))),
+            },
+        }
+    }
+
+    fn given(&self) -> Option<&'static str> {
+        match (self.ktx2, self.ktx2_quality) {
+            (Some(_), _) => Some("--ktx2"),
+            (_, Some(_)) => Some("--ktx2-quality"),
+            _ => None,
+        }
+    }
+}
+
+/// How glTF textures ship as KTX2 (`bake --textures ktx2`, `textures`).
+#[derive(clap::Args, Debug)]
+pub struct ShipArgs {
+    #[command(flatten)]
+    pub ktx2: Ktx2Args,
+    /// Keep each PNG/JPEG as the texture's source for clients without KTX2
+    /// (KHR_texture_basisu used, not required).
+    #[arg(long)]
+    pub ktx2_fallback: bool,
+    /// Widen each roughness mip level by the variance its normal-map level lost (Toksvig;
+    /// HDRP/Filament normal filtering), in a new metallicRoughness texture [default: on].
+    #[arg(long, overrides_with = "no_specular_aa")]
+    pub specular_aa: bool,
+    /// Leave roughness as it is.
+    #[arg(long, overrides_with = "specular_aa")]
+    pub no_specular_aa: bool,
+    /// Cap of the widening, in GGX alpha: a' = sqrt(a^2 + min(2 variance, T^2)) [default: 0.2].
+    #[arg(long, value_name = "T")]
+    pub specular_aa_threshold: Option<f32>,
+}
+
+impl ShipArgs {
+    pub fn options(&self) -> Result<ShipOptions> {
+        let threshold = self.specular_aa_threshold.unwrap_or(DEFAULT_THRESHOLD);
+        if !(0.0..=1.0).contains(&threshold) {
+            return Err(Error::usage(format!("--specular-aa-threshold {threshold}: give a number from 0 to 1")));
+        }
+        Ok(ShipOptions {
+            codec: self.ktx2.codec()?,
+            fallback: self.ktx2_fallback,
+            specular_aa: !self.no_specular_aa,
+            threshold,
+        })
+    }
+
+    /// The first option given that only KTX2 output reads.
+    pub fn given(&self) -> Option<&'static str> {
+        self.ktx2.given().or(if self.ktx2_fallback {
+            Some("--ktx2-fallback")
+        } else if self.specular_aa || self.no_specular_aa {
+            Some("--specular-aa")
+        } else if self.specular_aa_threshold.is_some() {
+            Some("--specular-aa-threshold")
+        } else {
+            None
+        })
     }
 }
 

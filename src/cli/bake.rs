@@ -1,6 +1,6 @@
 //! `bumpbake bake MESH [--height H | --normal N] -o OUT`.
 
-use super::args::{ChannelArg, ConventionArg, FilterArg};
+use super::args::{ChannelArg, ConventionArg, FilterArg, TexturesArg};
 use bumpbake::bake::maps::HeightSettings;
 use bumpbake::bake::{run as run_job, BakeJob, MapSource};
 use bumpbake::batch;
@@ -26,7 +26,8 @@ use std::path::{Path, PathBuf};
   bumpbake bake fixtures/bake/torus.obj -o torus.glb
   bumpbake bake scene.gltf --height bumps.png --material Stone --strength 4 -o scene.glb
   bumpbake bake model.obj --normal normal_dx.png --convention directx -o model.gltf --images external
-  bumpbake bake low.glb --from sculpt.glb -o low_baked.glb --size 2048 --samples 2 --miss-mask misses.png")]
+  bumpbake bake low.glb --from sculpt.glb -o low_baked.glb --size 2048 --samples 2 --miss-mask misses.png
+  bumpbake bake fixtures/bake/torus.obj -o torus.glb --textures ktx2 --ktx2-fallback")]
 pub struct Args {
     #[command(flatten)]
     pub io: super::args::MeshIo,
@@ -116,6 +117,12 @@ pub struct Args {
     /// Images inside the output (GLB, or .gltf's buffer) or as files beside a .gltf.
     #[arg(long, value_parser = ["embed", "external"], default_value = "embed")]
     pub images: String,
+    /// Normal maps as PNG, or as KTX2 (KHR_texture_basisu) with mips made from the
+    /// full-resolution normals and, unless --no-specular-aa, roughness widened to match.
+    #[arg(long, value_enum, default_value_t = TexturesArg::Png)]
+    pub textures: TexturesArg,
+    #[command(flatten)]
+    pub ship: super::args::ShipArgs,
     #[command(flatten)]
     pub batch: super::args::BatchArgs,
 }
@@ -131,6 +138,11 @@ pub fn run(a: Args) -> Result<u8> {
         return Err(Error::usage("--strength must be finite"));
     }
     let transfer = transfer_settings(&a)?;
+    let textures = match (a.textures, a.ship.given()) {
+        (TexturesArg::Ktx2, _) => Some(a.ship.options()?),
+        (TexturesArg::Png, Some(flag)) => return Err(Error::usage(format!("{flag} needs --textures ktx2"))),
+        (TexturesArg::Png, None) => None,
+    };
     let job = |input: &Path, output: &Path| BakeJob {
         mesh: input.to_path_buf(),
         output: output.to_path_buf(),
@@ -159,6 +171,7 @@ pub fn run(a: Args) -> Result<u8> {
         },
         write: WriteOptions { images_external: a.images == "external", ..Default::default() },
         depfile: a.io.depfile.clone(),
+        textures,
     };
     let opts = a.batch.options(a.io.inputs.len());
     let results = batch::run(&a.io.inputs, &opts, |input| {

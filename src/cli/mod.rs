@@ -13,6 +13,7 @@ mod preview;
 mod print;
 mod progress;
 mod tangents;
+mod textures;
 mod validate;
 
 use bumpbake::Result;
@@ -45,6 +46,8 @@ pub enum Command {
     Man(completions::ManArgs),
     /// Render an asset with the reference bump-mapping model (CPU), or compare two.
     Preview(preview::Args),
+    /// Re-encode glTF normal maps as KTX2 (KHR_texture_basisu) with mips made from the normals, and widen roughness to match.
+    Textures(textures::Args),
 }
 
 impl Cli {
@@ -66,5 +69,6 @@ pub fn run(cli: Cli) -> Result<u8> {
         Command::Completions(a) => completions::completions(a),
         Command::Man(a) => completions::man(a),
         Command::Preview(a) => preview::run(a),
+        Command::Textures(a) => textures::run(a),
     }
 }

@@ -1,9 +1,8 @@
 //! `bumpbake normalmap HEIGHT -o NORMAL`: parses, checks the numbers, shows progress on a
 //! terminal, and hands the rest to `bumpbake::normalmap::convert_file`.
 
-use super::args::{ChannelArg, ConventionArg, FilterArg, WrapArg};
+use super::args::{ChannelArg, ConventionArg, FilterArg, TexturesArg, WrapArg};
 use bumpbake::batch;
-use bumpbake::format::image::ktx2::Codec;
 use bumpbake::normalmap::{self as nm, Channel, Convention, Convert, Converted, EncodeOptions, Filter, Options, Wrap};
 use bumpbake::progress::Reporter;
 use bumpbake::{Error, Result};
@@ -15,26 +14,6 @@ use std::path::{Path, PathBuf};
 pub enum Alpha {
     /// The height (after --invert), for parallax mapping.
     Height,
-}
-
-/// The Basis Universal codec of KTX2 output.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Ktx2Codec {
-    Uastc,
-    Etc1s,
-}
-
-fn codec(args: &Args) -> Result<Codec> {
-    match (args.ktx2, args.ktx2_quality) {
-        (Ktx2Codec::Uastc, q) => match q.unwrap_or(nm::DEFAULT_UASTC_LEVEL) {
-            level @ 0..=4 => Ok(Codec::Uastc { level }),
-            q => Err(Error::usage(format!("--ktx2-quality {q}: UASTC levels are 0 to 4"))),
-        },
-        (Ktx2Codec::Etc1s, q) => match q.unwrap_or(nm::DEFAULT_ETC1S_QUALITY) {
-            quality @ 1..=255 => Ok(Codec::Etc1s { quality }),
-            q => Err(Error::usage(format!("--ktx2-quality {q}: ETC1S quality is 1 to 255"))),
-        },
-    }
 }
 
 #[derive(clap::Args, Debug)]
@@ -54,13 +33,12 @@ pub struct Args {
     /// Extension of the outputs written into --out-dir.
     #[arg(long, value_parser = ["png", "tif", "exr", "ktx2"], default_value = "png")]
     pub out_ext: String,
-    /// Basis Universal codec of .ktx2 outputs: uastc (Zstandard-supercompressed, higher quality)
-    /// or etc1s (BasisLZ, smaller).
-    #[arg(long, value_enum, default_value_t = Ktx2Codec::Uastc)]
-    pub ktx2: Ktx2Codec,
-    /// KTX2 quality: UASTC pack level 0-4 [default: 2], ETC1S quality 1-255 [default: 128].
-    #[arg(long, value_name = "Q")]
-    pub ktx2_quality: Option<u32>,
+    /// png: -o's extension decides (.png, .tif, .exr); ktx2: a .ktx2 output (the default
+    /// extension of --out-dir outputs becomes ktx2).
+    #[arg(long, value_enum)]
+    pub textures: Option<TexturesArg>,
+    #[command(flatten)]
+    pub ktx2: super::args::Ktx2Args,
     /// Which channel holds the height (luma is Rec. 709; gray images use their gray value).
     #[arg(long, value_enum, default_value_t = ChannelArg::from(Channel::default()))]
     pub channel: ChannelArg,
@@ -125,9 +103,31 @@ fn strength(args: &Args) -> Result<f32> {
     Ok(s)
 }
 
+/// The extension of the outputs, after checking `--textures` against `-o` and `--out-ext`.
+fn out_ext(args: &Args) -> Result<String> {
+    let is_ktx2 = |e: &str| e.eq_ignore_ascii_case("ktx2");
+    let named = args.output.as_ref().map(|o| o.extension().and_then(|e| e.to_str()).unwrap_or("").to_string());
+    match (args.textures, named) {
+        (Some(TexturesArg::Ktx2), Some(e)) if !is_ktx2(&e) => {
+            Err(Error::usage(format!("--textures ktx2 writes .ktx2, but -o names a .{e} file")))
+        }
+        (Some(TexturesArg::Png), Some(e)) if is_ktx2(&e) => {
+            Err(Error::usage("--textures png contradicts -o NAME.ktx2: drop one of them"))
+        }
+        (Some(TexturesArg::Ktx2), None) if args.out_ext == "png" || is_ktx2(&args.out_ext) => Ok("ktx2".into()),
+        (Some(TexturesArg::Ktx2), None) => {
+            Err(Error::usage(format!("--textures ktx2 writes .ktx2, but --out-ext is {}", args.out_ext)))
+        }
+        (Some(TexturesArg::Png), None) if is_ktx2(&args.out_ext) => {
+            Err(Error::usage("--textures png contradicts --out-ext ktx2: drop one of them"))
+        }
+        _ => Ok(args.out_ext.clone()),
+    }
+}
+
 pub fn run(args: Args) -> Result<u8> {
-    let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &args.out_ext)?;
-    let ktx2 = codec(&args)?;
+    let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &out_ext(&args)?)?;
+    let ktx2 = args.ktx2.codec()?;
     let options =
         Options { strength: strength(&args)?, filter: args.filter.into(), wrap: args.wrap.into(), invert: args.invert };
     let convert = |input: &Path, output: &Path| -> Result<Convert> {

@@ -7,6 +7,7 @@
 //! longer referenced. OBJ input is converted into the same model on reading.
 
 pub mod accessor;
+pub mod basisu;
 pub(crate) mod compact;
 pub mod dequant;
 pub mod leave_out;

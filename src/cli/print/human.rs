@@ -9,6 +9,7 @@ use bumpbake::inspect::Inspection;
 use bumpbake::normalmap::Converted;
 use bumpbake::scene::Slot;
 use bumpbake::tangent::command::TangentsReport;
+use bumpbake::textures::{TexturesReport, TexturesRun};
 use bumpbake::transfer::TransferReport;
 
 /// What `tangents` did to one file.
@@ -111,10 +112,65 @@ impl Human for BakeReport {
         if let Some(tr) = &self.transfer {
             s += &transfer(tr);
         }
+        if let Some(t) = &self.textures {
+            s += &textures(t);
+        }
         let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
         s += &format!("  time: {}\n", times.join(", "));
         s
     }
+}
+
+/// What `bumpbake textures` did to one file.
+impl Human for TexturesRun {
+    fn human(&self) -> String {
+        let mut s = format!("{} -> {}\n", self.input.display(), self.output.display());
+        s += &textures(&self.textures);
+        let times: Vec<String> = self.timings_ms.stages.iter().map(|(n, ms)| format!("{n} {ms:.1} ms")).collect();
+        s += &format!("  time: {}\n", times.join(", "));
+        s
+    }
+}
+
+/// The textures shipped as KTX2, inside bake's and `textures`' text.
+fn textures(r: &TexturesReport) -> String {
+    let aa = if r.specular_aa { format!(", specular AA (threshold {})", r.threshold) } else { String::new() };
+    let fallback = if r.fallback { ", PNG/JPEG fallback kept" } else { "" };
+    let mut s = format!("  KTX2 {}{aa}{fallback}: {} normal map(s), {} bytes\n", r.codec, r.normal_maps, r.ktx2_bytes);
+    for m in &r.materials {
+        let name = m.name.as_deref().map(|n| format!(" '{n}'")).unwrap_or_default();
+        s += &format!(
+            "  material {}{name}: normal map {}x{}, {} levels, {} bytes\n",
+            m.material,
+            m.width,
+            m.height,
+            m.levels.len(),
+            m.bytes
+        );
+        for l in &m.levels {
+            let added = m.roughness.as_ref().and_then(|r| r.added.get(l.level));
+            let added =
+                added.map(|a| format!("  roughness +{:.3} mean, +{:.3} max", a.mean, a.max)).unwrap_or_default();
+            s += &format!(
+                "    level {:>2} {:>5}x{:<5} mean {:.2}°  p99 {:.2}°  mean length {:.4}{added}\n",
+                l.level, l.width, l.height, l.mean_deg, l.p99_deg, l.mean_length
+            );
+        }
+        if let Some(rr) = &m.roughness {
+            let from = if rr.from_texture { "its metallicRoughness texture" } else { "its factors" };
+            s += &format!(
+                "    roughness texture from {from} x roughnessFactor {} (now 1): {} bytes\n",
+                rr.roughness_factor, rr.bytes
+            );
+        }
+    }
+    for removal in &r.removed {
+        s += &format!("  left out {} ({} bytes)\n", removal.what, removal.bytes);
+    }
+    for n in &r.notes {
+        s += &format!("  note: {n}\n");
+    }
+    s
 }
 
 /// What `bake --from` did, inside bake's text.

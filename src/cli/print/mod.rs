@@ -51,6 +51,10 @@ impl Record for bumpbake::bake::BakeReport {
     const SCHEMA: &'static str = "bumpbake-bake/1";
 }
 
+impl Record for bumpbake::textures::TexturesRun {
+    const SCHEMA: &'static str = "bumpbake-textures/1";
+}
+
 impl Record for bumpbake::normalmap::Converted {
     const SCHEMA: &'static str = "bumpbake-normalmap/1";
 }
