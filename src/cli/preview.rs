@@ -1,8 +1,8 @@
 //! `bumpbake preview IN -o OUT.png` and `bumpbake preview --reference A --compare B -o diff.png`.
 
 use bumpbake::output::write_atomic;
-use bumpbake::preview::compare::{compare, Comparison, DiffKind};
-use bumpbake::preview::{render, Camera, CameraSpec, Light, Options, Params, Prepared, View};
+use bumpbake::preview::compare::{compare_with, Comparison, DiffKind};
+use bumpbake::preview::{render, Camera, CameraSpec, Light, Mips, Options, Params, Prepared, Shading, View};
 use bumpbake::scene::{ReadOptions, Scene};
 use bumpbake::{Error, Result};
 use clap::builder::PossibleValue;
@@ -15,7 +15,8 @@ use std::time::Instant;
 #[command(after_help = "Examples:
   bumpbake preview fixtures/khronos/NormalTangentMirrorTest.glb -o mirror.png --size 384x384 --ssaa 2
   bumpbake preview fixtures/spot/spot.obj -o spot.png --yaw 150 --pitch 15 --light dir:-1,-1,-1 --light point:0,1,2@0.4
-  bumpbake preview --reference high.glb --compare low.glb -o diff.png --json")]
+  bumpbake preview --reference high.glb --compare low.glb -o diff.png --json
+  bumpbake preview --reference plane.gltf --reference-mips off --reference-ssaa 16 --compare plane-ktx2.gltf --shading pbr -o diff.png")]
 pub struct Args {
     /// Input mesh: .glb, .gltf or .obj (with its .mtl).
     pub input: Option<PathBuf>,
@@ -25,9 +26,18 @@ pub struct Args {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "512x512", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Supersampling: N x N samples per pixel (1 to 8).
+    /// Supersampling: N x N samples per pixel (1 to 32), box-filtered.
     #[arg(long, default_value_t = 1)]
     pub ssaa: u32,
+    /// Where textures' mip levels come from: off (level 0 only; the supersampled truth), box
+    /// (the renderer's own 2x2 box chain, as generateMipmap makes), file (a KTX2's own levels,
+    /// else box).
+    #[arg(long, value_enum, default_value_t = MipsArg::from(Mips::default()))]
+    pub mips: MipsArg,
+    /// Lighting model: the course notes' Blinn-Phong, or glTF's metallic-roughness BRDF as
+    /// three.js's MeshStandardMaterial shades it.
+    #[arg(long, value_enum, default_value_t = ShadingArg::from(Shading::default()))]
+    pub shading: ShadingArg,
     /// Camera rotation about +Y in degrees (0 looks from +Z).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub yaw: f32,
@@ -53,6 +63,12 @@ pub struct Args {
     /// Pipeline error: the asset to measure against the reference (or against IN).
     #[arg(long)]
     pub compare: Option<PathBuf>,
+    /// Compare mode: --mips for the reference render (default: as --mips).
+    #[arg(long, value_enum)]
+    pub reference_mips: Option<MipsArg>,
+    /// Compare mode: --ssaa for the reference render (default: as --ssaa); the truth takes 16.
+    #[arg(long)]
+    pub reference_ssaa: Option<u32>,
     /// What the difference image shows in compare mode.
     #[arg(long, value_enum, default_value_t = DiffArg::from(DiffKind::default()))]
     pub diff: DiffArg,
@@ -107,6 +123,23 @@ super::args::arg_enum! {
     pub enum DiffArg => DiffKind {
         Angle => Angle,
         Shaded => Shaded,
+    }
+}
+
+super::args::arg_enum! {
+    /// Where mip levels come from ([`Mips`]).
+    pub enum MipsArg => Mips {
+        Off => Off,
+        Box => Box,
+        File => File,
+    }
+}
+
+super::args::arg_enum! {
+    /// The lighting model ([`Shading`]).
+    pub enum ShadingArg => Shading {
+        BlinnPhong => BlinnPhong,
+        Pbr => Pbr,
     }
 }
 
@@ -192,12 +225,22 @@ pub fn run(a: Args) -> Result<u8> {
         width: a.size.0,
         height: a.size.1,
         ssaa: a.ssaa,
+        mips: a.mips.into(),
         camera: CameraSpec { yaw: a.yaw, pitch: a.pitch, distance: a.distance, fov: a.fov },
         lights,
         view,
-        params: Params { ambient: a.ambient, specular: a.specular, shininess: a.shininess },
+        params: Params { ambient: a.ambient, specular: a.specular, shininess: a.shininess, shading: a.shading.into() },
     };
     opts.check()?;
+    let reference_opts = Options {
+        mips: a.reference_mips.map(Into::into).unwrap_or(opts.mips),
+        ssaa: a.reference_ssaa.unwrap_or(opts.ssaa),
+        ..opts.clone()
+    };
+    reference_opts.check()?;
+    if a.compare.is_none() && (a.reference_mips.is_some() || a.reference_ssaa.is_some()) {
+        return Err(Error::usage("preview: --reference-mips and --reference-ssaa need --compare"));
+    }
     let start = Instant::now();
 
     if let Some(cand) = &a.compare {
@@ -214,7 +257,7 @@ pub fn run(a: Args) -> Result<u8> {
         }
         let r = read(reference, a.allow_outside)?;
         let c = read(cand, a.allow_outside)?;
-        let (cmp, img) = compare(&r, &c, &opts, a.diff.into())?;
+        let (cmp, img) = compare_with(&r, &reference_opts, &c, &opts, a.diff.into())?;
         write_atomic(&a.output, &img.to_png())?;
         let done = Compared {
             reference: reference.clone(),

@@ -2,7 +2,9 @@
 //! true surface (fine geometry with its own normals), seen from the same camera.
 //!
 //! The measure is the angle between the two renders' shading normals per pixel, plus the PSNR of
-//! the shaded images. Pixels near silhouettes are left out: there the two meshes legitimately
+//! the shaded images and the ratio of their mean brightness. The two renders may differ in
+//! options too ([`compare_with`]): a supersampled truth without mips against what a renderer
+//! draws with them. Pixels near silhouettes are left out: there the two meshes legitimately
 //! cover different pixels (the normal map cannot move an outline), and one bad outline pixel
 //! would otherwise dominate the maximum.
 
@@ -42,6 +44,12 @@ pub struct Comparison {
     pub normal_angle_deg: Option<AngleStats>,
     /// PSNR of the 8-bit shaded images over the compared pixels (`None` when identical or empty).
     pub psnr_db: Option<f64>,
+    /// Mean 8-bit display value (all three channels) over the compared pixels, of the reference
+    /// and of the candidate (`None` when no pixel was compared).
+    pub mean_reference: Option<f64>,
+    pub mean_candidate: Option<f64>,
+    /// `mean_candidate / mean_reference`: above 1, the candidate draws brighter.
+    pub brightness_ratio: Option<f64>,
 }
 
 /// Pixels within this many of an edge are not compared.
@@ -52,12 +60,26 @@ pub const DEPTH_JUMP: f32 = 0.02;
 /// Renders `reference` and `candidate` shaded from a camera framed on the reference and measures
 /// the difference; returns the numbers and the difference image.
 pub fn compare(reference: &Scene, candidate: &Scene, opts: &Options, kind: DiffKind) -> Result<(Comparison, Frame)> {
+    compare_with(reference, opts, candidate, opts, kind)
+}
+
+/// [`compare`] with the reference rendered with its own options (mips, supersampling); size,
+/// camera, lights and view are `opts`'.
+pub fn compare_with(
+    reference: &Scene,
+    reference_opts: &Options,
+    candidate: &Scene,
+    opts: &Options,
+    kind: DiffKind,
+) -> Result<(Comparison, Frame)> {
     opts.check()?;
+    reference_opts.check()?;
     let a = Prepared::new(reference)?;
     let b = Prepared::new(candidate)?;
     let cam = Camera::framed(a.bounds, &opts.camera, opts.width, opts.height);
     let o = Options { view: View::Shaded, ..opts.clone() };
-    let fa = render(&a, &cam, &o);
+    let ro = Options { mips: reference_opts.mips, ssaa: reference_opts.ssaa, ..o.clone() };
+    let fa = render(&a, &cam, &ro);
     let fb = render(&b, &cam, &o);
     Ok(measure(&fa, &fb, kind))
 }
@@ -130,6 +152,7 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     let ok = mask(a, b);
     let mut angles = Vec::new();
     let mut se = 0.0f64;
+    let (mut sum_a, mut sum_b) = (0.0f64, 0.0f64);
     let mut diff = Frame {
         width: a.width,
         height: a.height,
@@ -147,6 +170,8 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
             angles.push(deg);
             for k in 0..3 {
                 se += (q(a.rgb[i][k]) - q(b.rgb[i][k])).powi(2);
+                sum_a += q(a.rgb[i][k]);
+                sum_b += q(b.rgb[i][k]);
             }
             match kind {
                 DiffKind::Angle => heat(deg),
@@ -174,6 +199,8 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     });
     let mse = if n > 0 { se / (3 * n) as f64 } else { 0.0 };
     let psnr = (mse > 0.0).then(|| 10.0 * (255.0f64 * 255.0 / mse).log10());
+    let mean = |sum: f64| (n > 0).then(|| sum / (3 * n) as f64);
+    let (mean_a, mean_b) = (mean(sum_a), mean(sum_b));
     (
         Comparison {
             width: a.width,
@@ -182,6 +209,9 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
             pixels_excluded: excluded,
             normal_angle_deg: stats,
             psnr_db: psnr,
+            mean_reference: mean_a,
+            mean_candidate: mean_b,
+            brightness_ratio: mean_a.zip(mean_b).filter(|(a, _)| *a > 0.0).map(|(a, b)| b / a),
         },
         diff,
     )

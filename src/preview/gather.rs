@@ -8,7 +8,7 @@
 //! texture's +v-up axis lies on the surface. What the values are, which UVs the frames follow and
 //! where each primitive is shown come from the scene's view ([`crate::scene::view`]).
 
-use super::texture::{Sampler, Texture};
+use super::texture::{Footprint, Mips, Sampler, Texture};
 use crate::error::Result;
 use crate::scene::material::{MaterialInfo, TextureUse};
 use crate::scene::nodes::{instances, Instance};
@@ -39,6 +39,23 @@ impl TexRef {
             None => uv,
         }
     }
+
+    /// Samples the texture at a fragment: `sets` the interpolated UV sets, `duv` their
+    /// derivatives per screen sample.
+    pub fn sample(&self, sets: &[Vec2; 2], duv: &[Footprint; 2], mips: Mips) -> Vec4 {
+        let uv = self.uv(sets);
+        let d = duv[self.texcoord as usize];
+        // The transform is affine: its linear part carries the derivatives.
+        let f = match &self.transform {
+            Some(t) => {
+                let at = |x: Vec2| Vec2::from(t.apply(x.to_array()));
+                let o = at(Vec2::ZERO);
+                Footprint { dx: at(d.dx) - o, dy: at(d.dy) - o }
+            }
+            None => d,
+        };
+        self.texture.sample_lod(&self.sampler, uv, &f, mips)
+    }
 }
 
 /// The parts of a glTF material the seeds' shading model uses.
@@ -49,6 +66,10 @@ pub struct Material {
     pub normal_texture: Option<TexRef>,
     /// `normalTexture.scale`: multiplies the decoded x and y.
     pub normal_scale: f32,
+    /// `metallicRoughnessTexture`: roughness in G, metalness in B.
+    pub metal_rough_texture: Option<TexRef>,
+    pub metallic: f32,
+    pub roughness: f32,
     pub double_sided: bool,
 }
 
@@ -59,6 +80,10 @@ impl Default for Material {
             base_texture: None,
             normal_texture: None,
             normal_scale: 1.0,
+            metal_rough_texture: None,
+            // glTF's defaults for both factors.
+            metallic: 1.0,
+            roughness: 1.0,
             double_sided: false,
         }
     }
@@ -278,6 +303,15 @@ impl Cx<'_> {
             m.normal_texture = self.tex_ref(t, false)?;
             m.normal_scale = t.scale.unwrap_or(1.0) as f32;
         }
+        if let Some(t) = info.texture(Slot::MetallicRoughness) {
+            // Only PBR shading reads it: an image it cannot use must not stop the other views.
+            m.metal_rough_texture = self.tex_ref(t, false).unwrap_or_else(|e| {
+                self.notes.push(format!("{}: metallicRoughnessTexture not used: {e}", info.label()));
+                None
+            });
+        }
+        m.metallic = info.metallic_factor.filter(|f| f.is_finite()).unwrap_or(1.0).clamp(0.0, 1.0);
+        m.roughness = info.roughness_factor.filter(|f| f.is_finite()).unwrap_or(1.0).clamp(0.0, 1.0);
         m.double_sided = info.double_sided;
         Ok(m)
     }

@@ -9,14 +9,18 @@
 //! - [`camera`]: perspective camera framed on the bounds.
 //! - [`gather`]: scene to world-space draws and materials.
 //! - [`raster`]: visibility (tiles, depth buffer, perspective-correct barycentrics).
-//! - [`texture`]: decoding and sampling with glTF's wrap modes.
+//! - [`lod`]: UV derivatives per screen sample, for the mip level.
+//! - [`texture`]: decoding, mip chains and sampling with glTF's sampler rules.
 //! - [`shade`]: the seeds' model (tangent-space lighting, Blinn-Phong, lights).
+//! - [`pbr`]: glTF's metallic-roughness BRDF (`Shading::Pbr`).
 //! - [`views`]: the debug views.
 //! - [`compare`]: pipeline error between two renders.
 
 pub mod camera;
 pub mod compare;
 pub mod gather;
+pub mod lod;
+pub mod pbr;
 pub mod raster;
 pub mod shade;
 pub mod texture;
@@ -24,7 +28,8 @@ pub mod views;
 
 pub use camera::{Camera, CameraSpec};
 pub use gather::Prepared;
-pub use shade::{Light, Params};
+pub use shade::{Light, Params, Shading};
+pub use texture::Mips;
 pub use views::View;
 
 use crate::scene::Scene;
@@ -39,6 +44,8 @@ pub struct Options {
     pub height: u32,
     /// Samples per pixel along each axis (box-filtered).
     pub ssaa: u32,
+    /// Where textures' mip levels come from.
+    pub mips: Mips,
     pub camera: CameraSpec,
     /// Empty: the camera-relative default rig ([`shade::default_lights`]).
     pub lights: Vec<Light>,
@@ -52,6 +59,7 @@ impl Default for Options {
             width: 512,
             height: 512,
             ssaa: 1,
+            mips: Mips::default(),
             camera: CameraSpec::default(),
             lights: Vec::new(),
             view: View::Shaded,
@@ -60,19 +68,28 @@ impl Default for Options {
     }
 }
 
-/// Largest number of samples one render may hold (memory stays around 2 GB at worst).
+/// Largest number of pixels, and of samples in one row of pixels (memory stays around 2 GB at
+/// worst).
 pub const MAX_SAMPLES: u64 = 1 << 26;
+/// Most samples per pixel along each axis: a supersampled truth needs 16 or more.
+pub const MAX_SSAA: u32 = 32;
+/// Samples resolved at once: larger renders go in bands of rows, so supersampling costs time,
+/// not memory.
+const BAND_SAMPLES: u64 = 1 << 23;
 
 impl Options {
     /// Checks sizes before any memory is committed to them.
     pub fn check(&self) -> Result<()> {
-        if self.width == 0 || self.height == 0 || self.ssaa == 0 || self.ssaa > 8 {
-            return Err(crate::Error::usage("preview: size must be at least 1x1 and --ssaa between 1 and 8"));
-        }
-        let n = self.width as u64 * self.height as u64 * (self.ssaa as u64).pow(2);
-        if n > MAX_SAMPLES {
+        if self.width == 0 || self.height == 0 || self.ssaa == 0 || self.ssaa > MAX_SSAA {
             return Err(crate::Error::usage(format!(
-                "preview: {}x{} with --ssaa {} is {n} samples; the limit is {MAX_SAMPLES}",
+                "preview: size must be at least 1x1 and --ssaa between 1 and {MAX_SSAA}"
+            )));
+        }
+        let n = self.width as u64 * self.height as u64;
+        let row = self.width as u64 * (self.ssaa as u64).pow(2);
+        if n > MAX_SAMPLES || row > MAX_SAMPLES {
+            return Err(crate::Error::usage(format!(
+                "preview: {}x{} with --ssaa {} is {n} pixels and {row} samples a row; the limit is {MAX_SAMPLES}",
                 self.width, self.height, self.ssaa
             )));
         }
@@ -124,52 +141,75 @@ pub fn render_scene(scene: &Scene, opts: &Options) -> Result<Frame> {
 
 /// Renders a prepared scene from `cam` (its width and height are ignored in favour of `opts`').
 pub fn render(prep: &Prepared, cam: &Camera, opts: &Options) -> Frame {
-    let ss = opts.ssaa.clamp(1, 8);
+    let ss = opts.ssaa.clamp(1, MAX_SSAA);
     let (sw, sh) = (opts.width * ss, opts.height * ss);
     let lights = if opts.lights.is_empty() { shade::default_lights(cam.eye, cam.target) } else { opts.lights.clone() };
-    let r = raster::rasterise(&prep.draws, &prep.materials, cam, sw, sh);
+    let prims = raster::setup_all(&prep.draws, &prep.materials, cam, sw, sh);
     let default_material = gather::Material::default();
+    // A physically based pixel is the mean radiance of its samples, each stored as an sRGB render
+    // target stores it (clamped): a GPU's MSAA resolve. The course model keeps its display-value
+    // mean, so its images stay as they were.
+    let linear = opts.params.shading == Shading::Pbr && matches!(opts.view, View::Shaded | View::Nomap);
+    let band = (BAND_SAMPLES / (sw as u64 * ss as u64)).clamp(1, opts.height as u64) as u32;
 
-    // Shade and resolve one output row at a time: its `ss` sample rows are independent of all
-    // others, so rows run in parallel and the result does not depend on scheduling.
-    let rows: Vec<Vec<(Vec3, Vec3, f32, f32)>> = (0..opts.height)
-        .into_par_iter()
-        .map(|y| {
-            let mut row = Vec::with_capacity(opts.width as usize);
-            for x in 0..opts.width {
-                let (mut rgb, mut nrm, mut hit, mut depth) = (Vec3::ZERO, Vec3::ZERO, 0u32, 0.0f32);
-                for sy in 0..ss {
-                    for sx in 0..ss {
-                        let s = r.samples[((y * ss + sy) * sw + x * ss + sx) as usize];
-                        if s.prim == raster::EMPTY {
-                            rgb += Vec3::from(views::BACKGROUND);
-                            continue;
+    let mut px = Vec::with_capacity((opts.width * opts.height) as usize);
+    for y0 in (0..opts.height).step_by(band as usize) {
+        let y1 = (y0 + band).min(opts.height);
+        let samples = raster::resolve(&prims, sw, y0 * ss..y1 * ss);
+        // Shade and resolve one output row at a time: its `ss` sample rows are independent of all
+        // others, so rows run in parallel and the result does not depend on scheduling.
+        let rows: Vec<Vec<(Vec3, Vec3, f32, f32)>> = (y0..y1)
+            .into_par_iter()
+            .map(|y| {
+                let mut row = Vec::with_capacity(opts.width as usize);
+                for x in 0..opts.width {
+                    let (mut rgb, mut nrm, mut hit, mut depth) = (Vec3::ZERO, Vec3::ZERO, 0u32, 0.0f32);
+                    for sy in 0..ss {
+                        for sx in 0..ss {
+                            let s = samples[(((y - y0) * ss + sy) * sw + x * ss + sx) as usize];
+                            if s.prim == raster::EMPTY {
+                                rgb += match linear {
+                                    true => Vec3::from(views::BACKGROUND.map(texture::srgb_to_linear)),
+                                    false => Vec3::from(views::BACKGROUND),
+                                };
+                                continue;
+                            }
+                            let p = &prims[s.prim as usize];
+                            let d = &prep.draws[p.draw as usize];
+                            let tri = d.triangles[p.tri as usize];
+                            let f = shade::Fragment {
+                                draw: d,
+                                material: prep.materials.get(d.material).unwrap_or(&default_material),
+                                tri,
+                                bary: p.whole_bary(s.b),
+                                back: p.back,
+                                duv: lod::footprints(p, d, tri, &s),
+                                mips: opts.mips,
+                            };
+                            let out = views::shade(opts.view, &f, cam.eye, &lights, &opts.params);
+                            rgb += match linear {
+                                true => Vec3::from(out.color.map(texture::srgb_to_linear)),
+                                false => Vec3::from(out.color),
+                            };
+                            nrm += out.normal;
+                            hit += 1;
+                            depth += s.depth;
                         }
-                        let p = &r.prims[s.prim as usize];
-                        let d = &prep.draws[p.draw as usize];
-                        let f = shade::Fragment {
-                            draw: d,
-                            material: prep.materials.get(d.material).unwrap_or(&default_material),
-                            tri: d.triangles[p.tri as usize],
-                            bary: p.whole_bary(s.b),
-                            back: p.back,
-                        };
-                        let out = views::shade(opts.view, &f, cam.eye, &lights, &opts.params);
-                        rgb += Vec3::from(out.color);
-                        nrm += out.normal;
-                        hit += 1;
-                        depth += s.depth;
                     }
+                    let n = (ss * ss) as f32;
+                    let cov = hit as f32 / n;
+                    let depth = if hit > 0 { depth / hit as f32 } else { f32::INFINITY };
+                    let rgb = match linear {
+                        true => (rgb / n).to_array().map(texture::linear_to_srgb).into(),
+                        false => rgb / n,
+                    };
+                    row.push((rgb, nrm.normalize_or_zero(), cov, depth));
                 }
-                let n = (ss * ss) as f32;
-                let cov = hit as f32 / n;
-                let depth = if hit > 0 { depth / hit as f32 } else { f32::INFINITY };
-                row.push((rgb / n, nrm.normalize_or_zero(), cov, depth));
-            }
-            row
-        })
-        .collect();
-    let px = rows.into_iter().flatten();
+                row
+            })
+            .collect();
+        px.extend(rows.into_iter().flatten());
+    }
     let mut frame = Frame {
         width: opts.width,
         height: opts.height,

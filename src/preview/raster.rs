@@ -52,6 +52,14 @@ impl Prim {
             Some(s) => s[0] * local.x + s[1] * local.y + s[2] * local.z,
         }
     }
+
+    /// Barycentrics in the scene triangle of this prim's corner `k`.
+    pub fn whole_bary_of_corner(&self, k: usize) -> Vec3 {
+        match &self.sub {
+            None => [Vec3::X, Vec3::Y, Vec3::Z][k],
+            Some(s) => s[k],
+        }
+    }
 }
 
 /// The visibility buffer of one image.
@@ -68,10 +76,17 @@ const TILE: u32 = 32;
 
 /// Rasterises every draw as `cam` sees it into a `width` x `height` sample grid.
 pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u32, height: u32) -> Raster {
+    let prims = setup_all(draws, materials, cam, width, height);
+    let samples = resolve(&prims, width, 0..height);
+    Raster { width, height, prims, samples }
+}
+
+/// Every triangle that may be seen, as screen-space prims of a `width` x `height` sample grid.
+pub fn setup_all(draws: &[Draw], materials: &[Material], cam: &Camera, width: u32, height: u32) -> Vec<Prim> {
     let (wf, hf) = (width as f32, height as f32);
     let clip: Vec<Vec<Vec4>> =
         draws.par_iter().map(|d| d.positions.par_iter().map(|&p| cam.clip(p)).collect()).collect();
-    let prims: Vec<Prim> = draws
+    draws
         .par_iter()
         .enumerate()
         .flat_map(|(di, d)| {
@@ -91,13 +106,23 @@ pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u3
                 })
             })
         })
-        .collect();
+        .collect()
+}
 
-    let (tx, ty) = (width.div_ceil(TILE), height.div_ceil(TILE));
+/// The samples of rows `rows` of a grid `width` wide (row-major, `rows.len() * width`). Each
+/// sample's answer depends only on the prims' order, so resolving an image in bands of rows gives
+/// the same samples as resolving it whole.
+pub fn resolve(prims: &[Prim], width: u32, rows: std::ops::Range<u32>) -> Vec<Sample> {
+    let (top, height) = (rows.start, rows.end);
+    let (tx, ty) = (width.div_ceil(TILE), (height - top).div_ceil(TILE));
     let mut bins: Vec<Vec<u32>> = vec![Vec::new(); (tx * ty) as usize];
     for (i, p) in prims.iter().enumerate() {
         let Some((x0, y0, x1, y1)) = pixel_box(p, width, height) else { continue };
-        for by in y0 / TILE..=y1 / TILE {
+        if y1 < top {
+            continue;
+        }
+        let y0 = y0.max(top);
+        for by in (y0 - top) / TILE..=(y1 - top) / TILE {
             for bx in x0 / TILE..=x1 / TILE {
                 bins[(by * tx + bx) as usize].push(i as u32);
             }
@@ -108,17 +133,11 @@ pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u3
         .enumerate()
         .map(|(k, bin)| {
             let (bx, by) = (k as u32 % tx, k as u32 / tx);
-            raster_tile(
-                &prims,
-                bin,
-                bx * TILE,
-                by * TILE,
-                (bx * TILE + TILE).min(width),
-                (by * TILE + TILE).min(height),
-            )
+            let y0 = top + by * TILE;
+            raster_tile(prims, bin, bx * TILE, y0, (bx * TILE + TILE).min(width), (y0 + TILE).min(height))
         })
         .collect();
-    let mut samples = vec![NONE; (width * height) as usize];
+    let mut samples = vec![NONE; (width * (height - top)) as usize];
     for (k, tile) in tiles.iter().enumerate() {
         let (bx, by) = (k as u32 % tx, k as u32 / tx);
         let (x0, y0) = (bx * TILE, by * TILE);
@@ -128,7 +147,7 @@ pub fn rasterise(draws: &[Draw], materials: &[Material], cam: &Camera, width: u3
             samples[at..at + tw as usize].copy_from_slice(row);
         }
     }
-    Raster { width, height, prims, samples }
+    samples
 }
 
 /// Inclusive pixel range a triangle may cover, or `None` when it misses the image.

@@ -14,6 +14,8 @@
 //! with the interpolated (not renormalised) frame, which is what MikkTSpace expects.
 
 use super::gather::{Draw, Material};
+use super::pbr;
+use super::texture::{Footprint, Mips};
 use glam::{Vec2, Vec3, Vec4};
 
 /// A light. Directions need not be unit length.
@@ -96,6 +98,17 @@ impl Light {
     }
 }
 
+/// The lighting model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Shading {
+    /// The course notes' (and `shaders/`') Blinn-Phong with [`Params`]' specular and shininess.
+    #[default]
+    BlinnPhong,
+    /// glTF's metallic-roughness BRDF as three.js shades it ([`pbr`]), from the material's
+    /// factors and `metallicRoughnessTexture`.
+    Pbr,
+}
+
 /// The constants of the lighting model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Params {
@@ -105,11 +118,12 @@ pub struct Params {
     pub specular: f32,
     /// Blinn-Phong exponent.
     pub shininess: f32,
+    pub shading: Shading,
 }
 
 impl Default for Params {
     fn default() -> Self {
-        Params { ambient: 0.06, specular: 0.25, shininess: 32.0 }
+        Params { ambient: 0.06, specular: 0.25, shininess: 32.0, shading: Shading::BlinnPhong }
     }
 }
 
@@ -139,6 +153,9 @@ pub struct Fragment<'a> {
     /// The camera sees the back of a double-sided surface: glTF flips the normal there, which in
     /// tangent space means negating every projected vector.
     pub back: bool,
+    /// How far each UV set moves per screen sample (for the mip level).
+    pub duv: [Footprint; 2],
+    pub mips: Mips,
 }
 
 /// The interpolated frame and vertex-stage outputs at a fragment.
@@ -214,7 +231,7 @@ impl Fragment<'_> {
         if self.draw.uvs[nt.texcoord as usize].is_empty() {
             return Vec3::Z;
         }
-        let texel = nt.texture.sample(&nt.sampler, nt.uv(&i.uv));
+        let texel = nt.sample(&i.uv, &self.duv, self.mips);
         let s = self.material.normal_scale;
         let n = (texel.truncate() * 2.0 - Vec3::ONE) * Vec3::new(s, s, 1.0);
         let n = n.normalize_or_zero();
@@ -230,10 +247,25 @@ impl Fragment<'_> {
         let mut c: Vec4 = self.material.base_color;
         if let Some(bt) = &self.material.base_texture {
             if !self.draw.uvs[bt.texcoord as usize].is_empty() {
-                c *= bt.texture.sample(&bt.sampler, bt.uv(&i.uv));
+                c *= bt.sample(&i.uv, &self.duv, self.mips);
             }
         }
         c.truncate().max(Vec3::ZERO)
+    }
+
+    /// The PBR material at the fragment: factors times `metallicRoughnessTexture` (roughness in
+    /// G, metalness in B).
+    pub fn surface(&self, i: &Interp, base_color: Vec3) -> pbr::Surface {
+        let m = self.material;
+        let (mut metallic, mut roughness) = (m.metallic, m.roughness);
+        if let Some(t) = &m.metal_rough_texture {
+            if !self.draw.uvs[t.texcoord as usize].is_empty() {
+                let texel = t.sample(&i.uv, &self.duv, self.mips);
+                roughness *= texel.y;
+                metallic *= texel.z;
+            }
+        }
+        pbr::Surface { base_color, metallic: metallic.clamp(0.0, 1.0), roughness: roughness.clamp(0.0, 1.0) }
     }
 
     /// World-space shading normal for the tangent-space normal `n` (flipped on back faces).
@@ -251,7 +283,11 @@ impl Fragment<'_> {
         let base = self.base_color(i);
         let (view, ls) = self.tangent_space(eye, lights);
         let v = view.normalize_or_zero();
-        let mut c = base * p.ambient;
+        let surface = (p.shading == Shading::Pbr).then(|| self.surface(i, base));
+        let mut c = match &surface {
+            Some(s) => s.diffuse() * p.ambient,
+            None => base * p.ambient,
+        };
         for (light, (to_l, axis)) in lights.iter().zip(ls) {
             let l = to_l.normalize_or_zero();
             if let Light::Spot { angle, .. } = light {
@@ -261,6 +297,10 @@ impl Fragment<'_> {
             }
             let nl = n.dot(l).max(0.0);
             if nl <= 0.0 {
+                continue;
+            }
+            if let Some(s) = &surface {
+                c += light.color() * pbr::direct(n, l, v, s);
                 continue;
             }
             let h = (l + v).normalize_or_zero();

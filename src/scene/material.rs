@@ -177,6 +177,9 @@ pub struct MaterialInfo {
     pub tangent_needs: Vec<TangentNeed>,
     /// `pbrMetallicRoughness.baseColorFactor`, when it is four numbers.
     pub base_color_factor: Option<[f32; 4]>,
+    /// `pbrMetallicRoughness.metallicFactor` and `roughnessFactor`, when they are numbers.
+    pub metallic_factor: Option<f32>,
+    pub roughness_factor: Option<f32>,
     pub double_sided: bool,
 }
 
@@ -385,12 +388,16 @@ impl Scene {
             .and_then(|f| f.as_array())
             .filter(|f| f.len() == 4)
             .map(|f| std::array::from_fn(|k| f[k].as_f64().unwrap_or(1.0) as f32));
+        let factor =
+            |k: &str| m.pointer(&format!("/pbrMetallicRoughness/{k}")).and_then(|f| f.as_f64()).map(|f| f as f32);
         MaterialInfo {
             index,
             name: m.get("name").and_then(|n| n.as_str()).map(String::from),
             textures,
             tangent_needs,
             base_color_factor,
+            metallic_factor: factor("metallicFactor"),
+            roughness_factor: factor("roughnessFactor"),
             double_sided: m.get("doubleSided").and_then(|d| d.as_bool()).unwrap_or(false),
         }
     }
