@@ -82,12 +82,10 @@ fn chain_of(bytes: &[u8], factor: f32) -> Option<Vec<(usize, usize, Vec<f32>)>> 
 /// What material `m` gives as roughness, if it is a metal-roughness material whose roughness can
 /// be read (`None`: not checked).
 fn roughness_of(scene: &Scene, m: &MaterialInfo) -> Option<Roughness> {
-    let mat = scene.json.pointer(&format!("/materials/{}", m.index))?;
-    if mat.pointer("/extensions/KHR_materials_pbrSpecularGlossiness").is_some() {
+    if scene.is_specular_glossiness(m.index) {
         return None;
     }
-    let factor = mat.pointer("/pbrMetallicRoughness/roughnessFactor").and_then(|v| v.as_f64()).unwrap_or(1.0);
-    let factor = factor.clamp(0.0, 1.0) as f32;
+    let factor = m.roughness_factor.unwrap_or(1.0).clamp(0.0, 1.0);
     let Some(t) = m.texture(Slot::MetallicRoughness) else { return Some(Roughness::Factor(factor)) };
     // The image a client with KHR_texture_basisu shows first: that is where a chain can be.
     let bytes = scene
