@@ -27,7 +27,7 @@ pub enum Ktx2Codec {
 fn codec(args: &Args) -> Result<Codec> {
     match (args.ktx2, args.ktx2_quality) {
         (Ktx2Codec::Uastc, q) => match q.unwrap_or(nm::DEFAULT_UASTC_LEVEL) {
-            level @ 0..=4 => Ok(Codec::Uastc { level }),
+            level @ 0..=4 => Ok(Codec::Uastc { level, rdo: None }),
             q => Err(Error::usage(format!("--ktx2-quality {q}: UASTC levels are 0 to 4"))),
         },
         (Ktx2Codec::Etc1s, q) => match q.unwrap_or(nm::DEFAULT_ETC1S_QUALITY) {
