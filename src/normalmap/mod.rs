@@ -38,7 +38,7 @@ pub use io::{
     colour_words, convert_file, decode_normal_image, image_bytes, load_height, load_normal_image, open_image,
     png_bytes, write_normal_image, Convert, Converted, OutputFormat, PngSettings, DEFAULT_MAX_PIXELS,
 };
-pub use ktx2::{ktx2_bytes, LevelError, DEFAULT_ETC1S_QUALITY, DEFAULT_UASTC_LEVEL};
+pub use ktx2::{ktx2_bytes, measure as measure_ktx2, LevelError, DEFAULT_ETC1S_QUALITY, DEFAULT_UASTC_LEVEL};
 pub use relief::{steepest_slope, Flatness, Verdict, EXACT_FLAT_DEG, NEARLY_FLAT_DEG};
 pub use rows::unit_normal;
 
