@@ -285,8 +285,8 @@ mod tests {
                     let m = [s[0] / area, s[1] / area, s[2] / area];
                     let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
                     assert!((l.mean_length[i] as f64 - len.min(1.0)).abs() < 1e-6, "{w}x{h} level {k} texel {i}");
-                    for c in 0..3 {
-                        assert!((l.ideal[i][c] as f64 - m[c] / len).abs() < 1e-6, "{w}x{h} level {k} texel {i}");
+                    for (got, want) in l.ideal[i].iter().zip(m) {
+                        assert!((*got as f64 - want / len).abs() < 1e-6, "{w}x{h} level {k} texel {i}");
                     }
                 }
             }
