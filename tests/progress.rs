@@ -163,7 +163,7 @@ fn normalmap_reports_its_rows() {
                 ..Default::default()
             },
             png: Default::default(),
-            ktx2: bumpbake::format::image::ktx2::Codec::Uastc { level: nm::DEFAULT_UASTC_LEVEL },
+            ktx2: bumpbake::format::image::ktx2::Codec::Uastc { level: nm::DEFAULT_UASTC_LEVEL, rdo: None },
         };
         nm::convert_file(&c, &progress).unwrap();
     }

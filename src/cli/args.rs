@@ -130,7 +130,7 @@ impl Ktx2Args {
     pub fn codec(&self) -> Result<Codec> {
         match (self.ktx2.unwrap_or(Ktx2Codec::Uastc), self.ktx2_quality) {
             (Ktx2Codec::Uastc, q) => match q.unwrap_or(nm::DEFAULT_UASTC_LEVEL) {
-                level @ 0..=4 => Ok(Codec::Uastc { level }),
+                level @ 0..=4 => Ok(Codec::Uastc { level, rdo: None }),
                 q => Err(Error::usage(format!("--ktx2-quality {q}: UASTC levels are 0 to 4"))),
             },
             (Ktx2Codec::Etc1s, q) => match q.unwrap_or(nm::DEFAULT_ETC1S_QUALITY) {

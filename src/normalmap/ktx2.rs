@@ -6,6 +6,7 @@ use super::mips::{self, MipLevel};
 use crate::format::image::ktx2::{self, Codec, Level};
 use crate::format::image::Limits;
 use crate::timings::Timings;
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// UASTC pack level when none is given: the encoder's own default, its best speed/quality trade.
@@ -55,7 +56,7 @@ pub fn measure(bytes: &[u8], levels: &[MipLevel]) -> crate::error::Faulty<Vec<Le
         );
     }
     Ok(stored
-        .iter()
+        .par_iter()
         .zip(levels)
         .enumerate()
         .map(|(k, (img, l))| {

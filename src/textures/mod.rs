@@ -40,7 +40,7 @@ pub struct ShipOptions {
 impl Default for ShipOptions {
     fn default() -> Self {
         ShipOptions {
-            codec: Codec::Uastc { level: DEFAULT_UASTC_LEVEL },
+            codec: Codec::Uastc { level: DEFAULT_UASTC_LEVEL, rdo: None },
             fallback: false,
             specular_aa: true,
             threshold: DEFAULT_THRESHOLD,
@@ -93,7 +93,7 @@ pub struct TexturesReport {
 
 fn codec_words(c: Codec) -> String {
     match c {
-        Codec::Uastc { level } => format!("uastc level {level}"),
+        Codec::Uastc { level, .. } => format!("uastc level {level}"),
         Codec::Etc1s { quality } => format!("etc1s quality {quality}"),
     }
 }

