@@ -310,3 +310,35 @@ fn bad_inputs_and_options_exit_2() {
     run_ok(&["normalmap", s(&bumps), "-o", s(&ktx_out), "--textures", "ktx2"]);
     assert!(std::fs::read(&ktx_out).unwrap().starts_with(&[0xAB, b'K', b'T', b'X']));
 }
+
+/// `bake --from` ships the map it baked: the KTX2's level 0 is the PNG bake's map within UASTC's
+/// error, and the chain is full (64² has 7 levels).
+#[test]
+fn bake_from_ships_the_baked_map() {
+    let d = validated_dir("textures_bake_from");
+    let low = fixture("blender_scene/plain/torus_low.glb");
+    let high = fixture("blender_scene/plain/torus_high.glb");
+    let (png, ktx) = (d.join("png.glb"), d.join("ktx2.glb"));
+    run_ok(&["bake", s(&low), "--from", s(&high), "-o", s(&png), "--size", "64", "-q"]);
+    record_input(&png, &low, &[]);
+    let o =
+        run_ok(&["bake", s(&low), "--from", s(&high), "-o", s(&ktx), "--size", "64", "--textures", "ktx2", "--json"]);
+    record(&ktx, &png);
+    assert!(report(&o).get("textures").is_some(), "a textures record");
+    let (a, b) = (load(&png), load(&ktx));
+    let t = b.json.pointer("/materials/0/normalTexture/index").and_then(Value::as_u64).unwrap();
+    let levels = ktx2_levels(&b, t);
+    assert_eq!(levels.iter().map(|l| l.width()).collect::<Vec<_>>(), [64, 32, 16, 8, 4, 2, 1]);
+    let ta = a.json.pointer("/materials/0/normalTexture/index").and_then(Value::as_u64).unwrap();
+    let baked =
+        image::load_from_memory(&a.image_bytes(a.texture_image(ta as usize).unwrap()).unwrap()).unwrap().to_rgb8();
+    let n = |p: &image::Rgb<u8>| {
+        let v = p.0.map(|c| c as f32 / 127.5 - 1.0);
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        [v[0] / l, v[1] / l, v[2] / l]
+    };
+    let angles: Vec<f64> = baked.pixels().zip(levels[0].pixels()).map(|(p, q)| deg(n(p), n(q))).collect();
+    let mean = angles.iter().sum::<f64>() / angles.len() as f64;
+    assert!(mean < 3.0, "level 0 is the baked map within the codec's error: mean {mean:.2}°");
+    assert!(baked.pixels().any(|p| p.0[0].abs_diff(128) > 20), "the baked map is not flat");
+}

@@ -198,7 +198,7 @@ impl ShipArgs {
     }
 }
 
-/// Mesh inputs and where their outputs go, shared by `tangents` and `bake`.
+/// Mesh inputs and where their outputs go, shared by `tangents`, `bake` and `textures`.
 #[derive(clap::Args, Debug)]
 pub struct MeshIo {
     /// Input meshes: .obj (with its .mtl), .gltf or .glb.
@@ -225,6 +225,29 @@ impl MeshIo {
             return Err(Error::usage("--depfile takes one input"));
         }
         outputs(&self.inputs, &self.output, out_dir, &self.out_ext)
+    }
+
+    /// How each input is read: URIs kept inside its folder unless --allow-outside, and bars for
+    /// a lone input.
+    pub fn read_options(&self, batch: &BatchArgs) -> bumpbake::scene::ReadOptions {
+        bumpbake::scene::ReadOptions {
+            allow_outside: self.allow_outside,
+            progress: batch.single_progress(self.inputs.len()),
+            ..Default::default()
+        }
+    }
+
+    /// Runs `job` on every input and its output (`outputs`, as [`MeshIo::outputs`] paired them)
+    /// and prints the records.
+    pub fn run_each<R: super::print::Record + Send>(
+        &self,
+        outputs: &[PathBuf],
+        batch: &BatchArgs,
+        job: impl Fn(&Path, &Path) -> Result<R> + Sync,
+    ) -> Result<u8> {
+        let opts = batch.options(self.inputs.len());
+        let results = batch::run(&self.inputs, &opts, |input| job(input, paired(&self.inputs, outputs, input)))?;
+        super::print::all(&self.inputs, results, batch.json, batch.quiet)
     }
 }
 

@@ -3,7 +3,6 @@
 use super::args::{ChannelArg, ConventionArg, FilterArg, TexturesArg};
 use bumpbake::bake::maps::HeightSettings;
 use bumpbake::bake::{run as run_job, BakeJob, MapSource};
-use bumpbake::batch;
 use bumpbake::format::WriteOptions;
 use bumpbake::normalmap::{Channel, Filter};
 use bumpbake::scene::ReadOptions;
@@ -164,20 +163,12 @@ pub fn run(a: Args) -> Result<u8> {
         normal_convention: if transfer.is_some() { None } else { a.convention.map(Into::into) },
         keep_all: a.keep_all,
         bitangents: a.bitangents,
-        read: ReadOptions {
-            allow_outside: a.io.allow_outside,
-            progress: a.batch.single_progress(a.io.inputs.len()),
-            ..Default::default()
-        },
+        read: a.io.read_options(&a.batch),
         write: WriteOptions { images_external: a.images == "external", ..Default::default() },
         depfile: a.io.depfile.clone(),
         textures,
     };
-    let opts = a.batch.options(a.io.inputs.len());
-    let results = batch::run(&a.io.inputs, &opts, |input| {
-        run_job(&job(input, super::args::paired(&a.io.inputs, &outputs, input)))
-    })?;
-    super::print::all(&a.io.inputs, results, a.batch.json, a.batch.quiet)
+    a.io.run_each(&outputs, &a.batch, |input, output| run_job(&job(input, output)))
 }
 
 /// The `--from` options, checked; `None` without `--from`.

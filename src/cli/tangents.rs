@@ -1,6 +1,5 @@
 //! `bumpbake tangents IN... -o OUT | --out-dir DIR`.
 
-use bumpbake::batch;
 use bumpbake::format::WriteOptions;
 use bumpbake::scene::{NormalMode, ReadOptions};
 use bumpbake::tangent::apply::ApplyOptions;
@@ -63,9 +62,5 @@ pub fn run(a: Args) -> Result<u8> {
         write: WriteOptions { embed: a.embed, ..Default::default() },
         depfile: a.io.depfile.clone(),
     };
-    let opts = a.batch.options(a.io.inputs.len());
-    let results = batch::run(&a.io.inputs, &opts, |input| {
-        run_job(&job(input, super::args::paired(&a.io.inputs, &outputs, input)))
-    })?;
-    super::print::all(&a.io.inputs, results, a.batch.json, a.batch.quiet)
+    a.io.run_each(&outputs, &a.batch, |input, output| run_job(&job(input, output)))
 }

@@ -1,8 +1,6 @@
 //! `bumpbake textures IN... -o OUT | --out-dir DIR`.
 
-use bumpbake::batch;
 use bumpbake::format::WriteOptions;
-use bumpbake::scene::ReadOptions;
 use bumpbake::textures::{run as run_job, TexturesJob};
 use bumpbake::Result;
 use std::path::Path;
@@ -31,17 +29,9 @@ pub fn run(a: Args) -> Result<u8> {
         input: input.to_path_buf(),
         output: output.to_path_buf(),
         options,
-        read: ReadOptions {
-            allow_outside: a.io.allow_outside,
-            progress: a.batch.single_progress(a.io.inputs.len()),
-            ..Default::default()
-        },
+        read: a.io.read_options(&a.batch),
         write: WriteOptions { images_external: a.images == "external", ..Default::default() },
         depfile: a.io.depfile.clone(),
     };
-    let opts = a.batch.options(a.io.inputs.len());
-    let results = batch::run(&a.io.inputs, &opts, |input| {
-        run_job(&job(input, super::args::paired(&a.io.inputs, &outputs, input)))
-    })?;
-    super::print::all(&a.io.inputs, results, a.batch.json, a.batch.quiet)
+    a.io.run_each(&outputs, &a.batch, |input, output| run_job(&job(input, output)))
 }
