@@ -13,8 +13,8 @@
 use basis_universal::{TranscodeParameters, Transcoder, TranscoderTextureFormat};
 
 /// `sizeof(basis_file_header)` and `sizeof(basis_slice_desc)`: packed little-endian fields.
-const HEADER: usize = 77;
-const SLICE: usize = 23;
+pub(super) const HEADER: usize = 77;
+pub(super) const SLICE: usize = 23;
 /// The `.basis` version the vendored transcoder reads (`BASISD_SUPPORTED_BASIS_VERSION`).
 const VERSION: u16 = 0x13;
 
@@ -159,10 +159,13 @@ pub(super) fn uastc(blocks: &[u8], w: u32, h: u32, alpha: bool) -> crate::error:
     transcode(&file, w, h)
 }
 
-fn u16_at(b: &[u8], at: usize) -> u16 {
+pub(super) fn u16_at(b: &[u8], at: usize) -> u16 {
     u16::from_le_bytes([b[at], b[at + 1]])
 }
-fn u32_at(b: &[u8], at: usize) -> usize {
+pub(super) fn u24_at(b: &[u8], at: usize) -> usize {
+    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], 0]) as usize
+}
+pub(super) fn u32_at(b: &[u8], at: usize) -> usize {
     u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]) as usize
 }
 

@@ -33,26 +33,14 @@ pub struct Level<'a> {
 /// The largest side the Basis Universal encoder takes (`BASISU_MAX_SUPPORTED_TEXTURE_DIMENSION`).
 pub const MAX_SIDE: u32 = 16384;
 
-const HEADER: usize = 77;
-const SLICE: usize = 23;
-const BASIS_LZ: u32 = 1;
-const ZSTD: u32 = 2;
+use super::basis::{u16_at, u24_at, u32_at, HEADER, SLICE};
+use super::{BASIS_LZ, ZSTD};
 /// basisu's own Zstandard level for UASTC (`-ktx2_zstandard_level`, default 6).
 const ZSTD_LEVEL: i32 = 6;
 /// The encoder splits its RDO pass into `min(4, threads)` runs, each with its own dictionary, so
 /// its bytes depend on the thread count below 4: RDO encodes always get a pool of at least 4.
 const RDO_THREADS: u32 = 4;
 const WRITER: &str = concat!("bumpbake ", env!("CARGO_PKG_VERSION"));
-
-fn u16_at(b: &[u8], at: usize) -> u16 {
-    u16::from_le_bytes([b[at], b[at + 1]])
-}
-fn u24_at(b: &[u8], at: usize) -> usize {
-    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], 0]) as usize
-}
-fn u32_at(b: &[u8], at: usize) -> usize {
-    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]) as usize
-}
 
 /// The encoder's `.basis` file of `levels` (level 0 first).
 fn basis_file(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Faulty<Vec<u8>> {
