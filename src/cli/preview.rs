@@ -2,7 +2,7 @@
 
 use bumpbake::output::write_atomic;
 use bumpbake::preview::compare::{compare_with, Comparison, DiffKind};
-use bumpbake::preview::{render, Camera, CameraSpec, Light, Mips, Options, Params, Prepared, Shading, View};
+use bumpbake::preview::{render, Camera, CameraSpec, Light, Mips, Options, Params, Prepared, Resolve, Shading, View};
 use bumpbake::scene::{ReadOptions, Scene};
 use bumpbake::{Error, Result};
 use clap::builder::PossibleValue;
@@ -38,6 +38,10 @@ pub struct Args {
     /// three.js's MeshStandardMaterial shades it.
     #[arg(long, value_enum, default_value_t = ShadingArg::from(Shading::default()))]
     pub shading: ShadingArg,
+    /// With --shading pbr and --ssaa: clamped (each sample clamped to white, then averaged: a plain
+    /// canvas's MSAA) or hdr (linear radiance averaged, then clamped: an HDR target's resolve).
+    #[arg(long, value_enum, default_value_t = ResolveArg::from(Resolve::default()))]
+    pub resolve: ResolveArg,
     /// Camera rotation about +Y in degrees (0 looks from +Z).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub yaw: f32,
@@ -136,6 +140,14 @@ super::args::arg_enum! {
 }
 
 super::args::arg_enum! {
+    /// How a physically based pixel averages its samples ([`Resolve`]).
+    pub enum ResolveArg => Resolve {
+        Clamped => Clamped,
+        Hdr => Hdr,
+    }
+}
+
+super::args::arg_enum! {
     /// The lighting model ([`Shading`]).
     pub enum ShadingArg => Shading {
         BlinnPhong => BlinnPhong,
@@ -226,6 +238,7 @@ pub fn run(a: Args) -> Result<u8> {
         height: a.size.1,
         ssaa: a.ssaa,
         mips: a.mips.into(),
+        resolve: a.resolve.into(),
         camera: CameraSpec { yaw: a.yaw, pitch: a.pitch, distance: a.distance, fov: a.fov },
         lights,
         view,

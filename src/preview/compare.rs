@@ -50,6 +50,14 @@ pub struct Comparison {
     pub mean_candidate: Option<f64>,
     /// `mean_candidate / mean_reference`: above 1, the candidate draws brighter.
     pub brightness_ratio: Option<f64>,
+    /// Mean relative luminance (Rec. 709 weights of the 8-bit values decoded to linear) over the
+    /// compared pixels: the light that reaches the eye, which a prefiltered texture can keep and
+    /// which display values bend (a truth that varies from pixel to pixel has a darker mean
+    /// display value than its smooth mean, by the sRGB curve's bend).
+    pub mean_luminance_reference: Option<f64>,
+    pub mean_luminance_candidate: Option<f64>,
+    /// `mean_luminance_candidate / mean_luminance_reference`.
+    pub luminance_ratio: Option<f64>,
 }
 
 /// Pixels within this many of an edge are not compared.
@@ -153,6 +161,7 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     let mut angles = Vec::new();
     let mut se = 0.0f64;
     let (mut sum_a, mut sum_b) = (0.0f64, 0.0f64);
+    let (mut lum_a, mut lum_b) = (0.0f64, 0.0f64);
     let mut diff = Frame {
         width: a.width,
         height: a.height,
@@ -163,11 +172,20 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     };
     let mut excluded = 0;
     let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as f64;
+    let luminance = |c: [f32; 3]| -> f64 {
+        [0.2126, 0.7152, 0.0722]
+            .iter()
+            .zip(c)
+            .map(|(w, x)| w * super::texture::srgb_to_linear((q(x) / 255.0) as f32) as f64)
+            .sum()
+    };
     for (i, &both) in ok.iter().enumerate() {
         let covered = a.coverage[i] > 0.0 || b.coverage[i] > 0.0;
         let c = if both {
             let deg = angle_deg(a.normal[i], b.normal[i]);
             angles.push(deg);
+            lum_a += luminance(a.rgb[i]);
+            lum_b += luminance(b.rgb[i]);
             for k in 0..3 {
                 se += (q(a.rgb[i][k]) - q(b.rgb[i][k])).powi(2);
                 sum_a += q(a.rgb[i][k]);
@@ -201,6 +219,7 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
     let psnr = (mse > 0.0).then(|| 10.0 * (255.0f64 * 255.0 / mse).log10());
     let mean = |sum: f64| (n > 0).then(|| sum / (3 * n) as f64);
     let (mean_a, mean_b) = (mean(sum_a), mean(sum_b));
+    let (lum_a, lum_b) = (mean(3.0 * lum_a), mean(3.0 * lum_b));
     (
         Comparison {
             width: a.width,
@@ -212,6 +231,9 @@ pub fn measure(a: &Frame, b: &Frame, kind: DiffKind) -> (Comparison, Frame) {
             mean_reference: mean_a,
             mean_candidate: mean_b,
             brightness_ratio: mean_a.zip(mean_b).filter(|(a, _)| *a > 0.0).map(|(a, b)| b / a),
+            mean_luminance_reference: lum_a,
+            mean_luminance_candidate: lum_b,
+            luminance_ratio: lum_a.zip(lum_b).filter(|(a, _)| *a > 0.0).map(|(a, b)| b / a),
         },
         diff,
     )

@@ -46,6 +46,8 @@ pub struct Options {
     pub ssaa: u32,
     /// Where textures' mip levels come from.
     pub mips: Mips,
+    /// How a physically based pixel averages its samples.
+    pub resolve: Resolve,
     pub camera: CameraSpec,
     /// Empty: the camera-relative default rig ([`shade::default_lights`]).
     pub lights: Vec<Light>,
@@ -60,12 +62,25 @@ impl Default for Options {
             height: 512,
             ssaa: 1,
             mips: Mips::default(),
+            resolve: Resolve::default(),
             camera: CameraSpec::default(),
             lights: Vec::new(),
             view: View::Shaded,
             params: Params::default(),
         }
     }
+}
+
+/// How `Shading::Pbr` averages a pixel's samples (the course model always averages display values).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Resolve {
+    /// Each sample clamped to what an 8-bit sRGB target stores, then averaged in linear: a GPU's
+    /// MSAA resolve of a plain canvas. A highlight brighter than white loses what the clamp cut.
+    #[default]
+    Clamped,
+    /// The samples' linear radiance averaged before the clamp: an HDR target's resolve, and the
+    /// mean a prefiltered texture can aim at (docs/preview.md, "The truth's resolve").
+    Hdr,
 }
 
 /// Largest number of pixels, and of samples in one row of pixels (memory stays around 2 GB at
@@ -146,9 +161,9 @@ pub fn render(prep: &Prepared, cam: &Camera, opts: &Options) -> Frame {
     let lights = if opts.lights.is_empty() { shade::default_lights(cam.eye, cam.target) } else { opts.lights.clone() };
     let prims = raster::setup_all(&prep.draws, &prep.materials, cam, sw, sh);
     let default_material = gather::Material::default();
-    // A physically based pixel is the mean radiance of its samples, each stored as an sRGB render
-    // target stores it (clamped): a GPU's MSAA resolve. The course model keeps its display-value
-    // mean, so its images stay as they were.
+    // A physically based pixel is the mean radiance of its samples, clamped per sample or after
+    // the mean as `opts.resolve` says. The course model keeps its display-value mean, so its
+    // images stay as they were.
     let linear = opts.params.shading == Shading::Pbr && matches!(opts.view, View::Shaded | View::Nomap);
     let band = (BAND_SAMPLES / (sw as u64 * ss as u64)).clamp(1, opts.height as u64) as u32;
 
@@ -187,9 +202,10 @@ pub fn render(prep: &Prepared, cam: &Camera, opts: &Options) -> Frame {
                                 mips: opts.mips,
                             };
                             let out = views::shade(opts.view, &f, cam.eye, &lights, &opts.params);
-                            rgb += match linear {
-                                true => Vec3::from(out.color.map(texture::srgb_to_linear)),
-                                false => Vec3::from(out.color),
+                            rgb += match (linear, out.radiance) {
+                                (true, Some(r)) if opts.resolve == Resolve::Hdr => r,
+                                (true, _) => Vec3::from(out.color.map(texture::srgb_to_linear)),
+                                (false, _) => Vec3::from(out.color),
                             };
                             nrm += out.normal;
                             hit += 1;

@@ -48,10 +48,12 @@ impl View {
     }
 }
 
-/// One shaded sample: its display colour and its world-space shading normal.
+/// One shaded sample: its display colour, its world-space shading normal and, in the lit views,
+/// the linear radiance before the display clamps it.
 pub struct Shaded {
     pub color: [f32; 3],
     pub normal: Vec3,
+    pub radiance: Option<Vec3>,
 }
 
 fn as_color(v: Vec3) -> [f32; 3] {
@@ -64,9 +66,11 @@ pub fn shade(view: View, f: &Fragment, eye: Vec3, lights: &[Light], p: &Params) 
     let i = f.interp();
     let n_ts = if view == View::Nomap { Vec3::Z } else { f.map_normal(&i) };
     let normal = f.world_normal(&i, n_ts);
+    let mut radiance = None;
     let color = match view {
         View::Shaded | View::Nomap => {
             let c = f.lit(&i, n_ts, eye, lights, p);
+            radiance = Some(c);
             [linear_to_srgb(c.x), linear_to_srgb(c.y), linear_to_srgb(c.z)]
         }
         View::Normal => as_color(normal),
@@ -80,5 +84,5 @@ pub fn shade(view: View, f: &Fragment, eye: Vec3, lights: &[Light], p: &Params) 
             }
         }
     };
-    Shaded { color, normal }
+    Shaded { color, normal, radiance }
 }
