@@ -4,15 +4,20 @@
 # chain plus specular antialiasing, at roughness 0.15 and 0.5, measured by three.js in headless
 # Chromium against the supersampled level-0 truth under three lights (highlight in view, half in
 # view, out of view).
-#   bash tools/threejs/run.sh [BUMPBAKE] [WORKDIR]
+#   bash tools/threejs/run.sh [BUMPBAKE] [WORKDIR] [ASSET]
+# ASSET: empty (twelve waves, bake --strength 3) or noise (random bumps, --strength 4.6: the same
+# mean normal length at level 3, 0.986; writes threejs-specular-aa-noise.json).
 # Needs: python3, node, /usr/bin/chromium (Debian's chromium), `npm ci` in tools/threejs.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 bb=${1:-bumpbake}
 work=${2:-$(mktemp -d)}
+asset=${3:-}
+strength=3 out=threejs-specular-aa.json
+if [ "$asset" = noise ]; then strength=4.6 out=threejs-specular-aa-noise.json; fi
 cd "$work"
-python3 "$here/make_asset.py"
-"$bb" bake plane.obj --height height.png --strength 3 -o plane.gltf --quiet
+python3 "$here/make_asset.py" $asset
+"$bb" bake plane.obj --height height.png --strength $strength -o plane.gltf --quiet
 rows=()
 for r in 0.15 0.5; do
   python3 - "$r" <<'PY'
@@ -37,5 +42,5 @@ const fs = require("fs");
 const runs = fs.readdirSync(".").filter((f) => f.startsWith("m_") && f.endsWith(".json")).sort()
   .map((f) => { const j = JSON.parse(fs.readFileSync(f)); const [, r, light] = f.slice(0, -5).split("_");
     return { roughness: +r, light, rows: j.rows.map(({ textures, ...x }) => x) }; });
-fs.writeFileSync("threejs-specular-aa.json", JSON.stringify({ three: "0.187.0", size: 160, ssaa: 12, runs }, null, 1) + "\n");'
-echo "written: $work/threejs-specular-aa.json"
+fs.writeFileSync(process.argv[1], JSON.stringify({ three: "0.187.0", size: 160, ssaa: 12, runs }, null, 1) + "\n");' "$out"
+echo "written: $work/$out"

@@ -30,6 +30,18 @@ pub(super) fn fingerprint(bytes: &[u8]) -> String {
     format!("{h:016x}")
 }
 
+/// CPU seconds so far (user + system, every thread) of this process and of its children that
+/// have been waited for, from `/proc/self/stat` (`None` where there is none). Linux counts them
+/// in ticks of 1/100 s (`USER_HZ`, fixed by its ABI). Wall time on a shared machine carries the
+/// neighbours' load; CPU time is the work itself.
+pub(super) fn cpu_seconds() -> Option<(f64, f64)> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The fields after the command name, which is in parentheses and may hold spaces.
+    let rest = stat.get(stat.rfind(')')? + 2..)?;
+    let f: Vec<f64> = rest.split(' ').skip(11).take(4).map(|x| x.parse().ok()).collect::<Option<_>>()?;
+    (f.len() == 4).then(|| ((f[0] + f[1]) / 100.0, (f[2] + f[3]) / 100.0))
+}
+
 /// The smallest and largest of `v` ((inf, 0) when empty: times are never negative).
 pub(super) fn spread(v: &[f64]) -> (f64, f64) {
     (v.iter().copied().fold(f64::INFINITY, f64::min), v.iter().copied().fold(0.0, f64::max))
@@ -45,5 +57,23 @@ pub(super) fn median(v: &mut [f64]) -> f64 {
         v[n / 2]
     } else {
         0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Busy work on this thread shows in this process's CPU time and not in its children's.
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn cpu_seconds_count_this_process() {
+        let (a, ca) = super::cpu_seconds().expect("/proc/self/stat");
+        let t = std::time::Instant::now();
+        let mut x = 0u64;
+        while t.elapsed().as_millis() < 300 {
+            x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+        }
+        let (b, cb) = super::cpu_seconds().expect("/proc/self/stat");
+        assert!(b - a >= 0.2, "{a} -> {b}");
+        assert_eq!(ca, cb);
     }
 }

@@ -8,7 +8,7 @@
 mod report;
 
 use super::normalmap::heights;
-use super::shared::median;
+use super::shared::{cpu_seconds, median};
 use bumpbake::format::image::ktx2::Codec;
 use bumpbake::normalmap::{self as nm, mips};
 use bumpbake::timings::Timings;
@@ -105,6 +105,9 @@ pub struct Run {
     pub median_s: f64,
     pub min_s: f64,
     pub max_s: f64,
+    /// Median CPU seconds (user + system, all threads; Linux only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cpu_median_s: Option<f64>,
     pub bytes: usize,
     pub levels: Vec<LevelStat>,
     /// bumpbake only: median of each stage, ms (mips, encode, check).
@@ -120,6 +123,9 @@ pub struct Row {
     pub basisu: Run,
     /// bumpbake's median time over basisu's (below 1: bumpbake is faster).
     pub time_ratio: f64,
+    /// The same for CPU time: the work, without the neighbours' load.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cpu_ratio: Option<f64>,
     pub size_ratio: f64,
     /// The largest per-level difference, bumpbake minus basisu, of the mean and p99 errors
     /// (at most 0: no level is worse than basisu's).
@@ -226,20 +232,22 @@ fn one(
     let out_ours = dir.join("ours.ktx2");
     let out_theirs = dir.join("basisu.ktx2");
     let (mut ours_t, mut theirs_t) = (Vec::new(), Vec::new());
+    let (mut ours_cpu, mut theirs_cpu) = (Vec::new(), Vec::new());
     let mut stages: Vec<Vec<(String, f64)>> = Vec::new();
     let mut ours = None;
     // Interleaved, so that both tools see the same machine load.
     for _ in 0..runs {
-        let t0 = Instant::now();
+        let (t0, c0) = (Instant::now(), cpu_seconds());
         let mut t = Timings::default();
         let (bytes, report) =
             nm::ktx2_bytes(rgb, n, n, c, &mut t).map_err(|e| Error::usage(format!("bench textures: {e}")))?;
         bumpbake::output::write_atomic(&out_ours, &bytes)?;
         ours_t.push(t0.elapsed().as_secs_f64());
+        ours_cpu.push(c0.zip(cpu_seconds()).map(|(a, b)| b.0 - a.0));
         stages.push(t.stages);
         ours = Some((bytes.len(), report));
 
-        let t0 = Instant::now();
+        let (t0, c0) = (Instant::now(), cpu_seconds());
         let o = Command::new(exe)
             .args(basisu_args(c))
             .arg(png)
@@ -248,6 +256,7 @@ fn one(
             .output()
             .map_err(|e| Error::usage(format!("bench textures: cannot run basisu: {e}")))?;
         theirs_t.push(t0.elapsed().as_secs_f64());
+        theirs_cpu.push(c0.zip(cpu_seconds()).map(|(a, b)| b.1 - a.1));
         if !o.status.success() {
             let msg = String::from_utf8_lossy(&o.stdout);
             let last = msg.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("");
@@ -259,8 +268,8 @@ fn one(
     let theirs_err =
         nm::measure(&theirs, levels).map_err(|e| Error::usage(format!("bench textures: basisu's output: {e}")))?;
     let stat = |l: &nm::LevelError| LevelStat { level: l.level, mean_deg: l.mean_deg, p99_deg: l.p99_deg };
-    let bumpbake = summarise(&mut ours_t, bytes, report.iter().map(stat).collect(), median_stages(&stages));
-    let basisu = summarise(&mut theirs_t, theirs.len(), theirs_err.iter().map(stat).collect(), Vec::new());
+    let bumpbake = summarise(&mut ours_t, &ours_cpu, bytes, report.iter().map(stat).collect(), median_stages(&stages));
+    let basisu = summarise(&mut theirs_t, &theirs_cpu, theirs.len(), theirs_err.iter().map(stat).collect(), Vec::new());
     let excess = |f: fn(&LevelStat) -> f64| {
         bumpbake.levels.iter().zip(&basisu.levels).map(|(a, b)| f(a) - f(b)).fold(f64::NEG_INFINITY, f64::max)
     };
@@ -268,6 +277,7 @@ fn one(
         size: n,
         setting: setting_name(c),
         time_ratio: bumpbake.median_s / basisu.median_s.max(1e-9),
+        cpu_ratio: bumpbake.cpu_median_s.zip(basisu.cpu_median_s).filter(|(_, b)| *b > 0.0).map(|(a, b)| a / b),
         size_ratio: bumpbake.bytes as f64 / basisu.bytes.max(1) as f64,
         worst_mean_excess_deg: excess(|l| l.mean_deg),
         worst_p99_excess_deg: excess(|l| l.p99_deg),
@@ -276,9 +286,16 @@ fn one(
     })
 }
 
-fn summarise(times: &mut [f64], bytes: usize, levels: Vec<LevelStat>, stages_ms: Vec<(String, f64)>) -> Run {
+fn summarise(
+    times: &mut [f64],
+    cpu: &[Option<f64>],
+    bytes: usize,
+    levels: Vec<LevelStat>,
+    stages_ms: Vec<(String, f64)>,
+) -> Run {
     let (min_s, max_s) = super::shared::spread(times);
-    Run { median_s: median(times), min_s, max_s, bytes, levels, stages_ms }
+    let cpu_median_s = cpu.iter().copied().collect::<Option<Vec<f64>>>().map(|mut c| median(&mut c));
+    Run { median_s: median(times), min_s, max_s, cpu_median_s, bytes, levels, stages_ms }
 }
 
 /// Each stage's median over the runs (every run has the same stages in the same order).

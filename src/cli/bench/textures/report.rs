@@ -52,6 +52,9 @@ pub fn render_text(r: &Report) -> String {
         }
         let stages: Vec<String> = row.bumpbake.stages_ms.iter().map(|(n, ms)| format!("{n} {ms:.0}")).collect();
         let _ = writeln!(s, "bumpbake stages (ms): {}", stages.join(", "));
+        if let (Some(a), Some(b), Some(r)) = (row.bumpbake.cpu_median_s, row.basisu.cpu_median_s, row.cpu_ratio) {
+            let _ = writeln!(s, "CPU time, median s: bumpbake {a:.2}, basisu {b:.2}, ratio {r:.3}");
+        }
     }
     s
 }
@@ -86,6 +89,7 @@ mod tests {
             median_s: s,
             min_s: s,
             max_s: s,
+            cpu_median_s: None,
             bytes: 1000,
             levels: vec![LevelStat { level: 0, mean_deg: e, p99_deg: 2.0 * e }],
             stages_ms: vec![("encode".into(), s * 1e3)],
@@ -111,6 +115,7 @@ mod tests {
             bumpbake: run(1.5, 0.25),
             basisu: run(3.0, 0.5),
             time_ratio: 0.5,
+            cpu_ratio: None,
             size_ratio: 1.0,
             worst_mean_excess_deg: -0.25,
             worst_p99_excess_deg: -0.5,
