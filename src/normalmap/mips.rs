@@ -71,7 +71,8 @@ fn encode(v: [f64; 3]) -> ([u8; 3], [f32; 3], f64) {
 
 /// Unit normals of RGB8 texels (`2c/255 - 1`, renormalised; `+Z` for a zero vector).
 pub fn unit_normals(rgb: &[u8]) -> Vec<[f32; 3]> {
-    rgb.chunks_exact(3)
+    rgb.par_chunks_exact(3)
+        .with_min_len(4096)
         .map(|t| {
             let v = [decode8(t[0]), decode8(t[1]), decode8(t[2])];
             let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -102,6 +103,8 @@ pub fn build(normals: &[[f32; 3]], w: usize, h: usize) -> Vec<MipLevel> {
         let area = (w as f64 / lw as f64) * (h as f64 / lh as f64);
         let sums = match &above {
             Some((s, pw, ph)) if pw % lw == 0 && ph % lh == 0 => sum_blocks(s, *pw, lw, lh, pw / lw, ph / lh),
+            // Level 0's footprints are its own texels at weight 1: the sums are the normals.
+            None => normals.par_iter().with_min_len(4096).map(|n| n.map(f64::from)).collect(),
             _ => sum_footprints(normals, w, h, lw, lh),
         };
         let texels: Vec<Texel> = sums
@@ -207,7 +210,8 @@ pub fn scalar_levels(plane: &[f32], w: usize, h: usize) -> Vec<Vec<f32>> {
 /// Angles (degrees) between stored RGB8 texels and the ideal normals: mean and 99th percentile.
 pub fn angular_error(rgb: &[u8], ideal: &[[f32; 3]]) -> (f64, f64) {
     let mut deg: Vec<f64> = unit_normals(rgb)
-        .iter()
+        .par_iter()
+        .with_min_len(4096)
         .zip(ideal)
         .map(|(a, b)| {
             let d = a[0] as f64 * b[0] as f64 + a[1] as f64 * b[1] as f64 + a[2] as f64 * b[2] as f64;
