@@ -160,6 +160,11 @@ fn a_chain_filtered_without_renormalising_is_not_unit() {
     assert_eq!(f["total"], 8, "levels 1-8 are checked: {f:#}");
     assert!(f["metrics"]["worst_mean_length"].as_f64().unwrap() < 0.9, "{f:#}");
     assert_eq!(code, 0);
+    // The same file given bare on the command line: the same chain check.
+    let (code, r) = validate(&[s(&k.join("no_renorm.uastc.ktx2"))]);
+    assert_eq!(chain_findings(&r).0, ["NORMALMAP_MIPS_NOT_UNIT"], "{r:#}");
+    assert_eq!(finding(&r, "NORMALMAP_MIPS_NOT_UNIT")["total"], 8);
+    assert_eq!(code, 0);
 }
 
 /// One 1024² level and nothing below it: NORMALMAP_MIPS_MISSING, 10 of the 11 levels of a full
@@ -190,6 +195,9 @@ fn a_large_map_without_mips_is_missing_them() {
             }
             None => assert!(found.is_empty(), "{r:#}"),
         }
+        // Bare on the command line: the same verdict.
+        let (_, r) = validate(&[s(&k.join(format!("one_level_{n}.ktx2")))]);
+        assert_eq!(chain_findings(&r).0, found, "{r:#}");
     }
 }
 

@@ -306,6 +306,18 @@ pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
         let mut subject = Subject::new("image", name);
         let codec = lossy::Codec::sniff(&bytes);
         validate_normal_image(&img, codec, opts.image_convention, "the command line", &mut subject);
+        // A KTX2 carries its own chain: its levels get the checks a material's KTX2 gets.
+        if Kind::sniff(&bytes) == Kind::Ktx2 {
+            drop(img);
+            match img::ktx2::decode_levels_within(&bytes, &limits) {
+                Ok(imgs) => mip_levels::check(&mip_levels::levels(&imgs), codec, &mut subject),
+                Err(e) => {
+                    let why = format!("mip levels not checked: {e}");
+                    let f = Finding::new(Code::NORMALMAP_UNREADABLE, 1, 1, "images", why);
+                    subject.check(Code::NORMALMAP_UNREADABLE, Some(f));
+                }
+            }
+        }
         FileReport { path: path.to_path_buf(), kind: "image", subjects: vec![subject] }
     };
     apply_policy(&mut rep, opts);

@@ -16,7 +16,7 @@ import puppeteer from 'puppeteer-core';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const args = process.argv.slice(2);
-const opt = { size: 128, ssaa: 16, distances: [], files: [], fov: 30, pitch: 35, truth: null, light: [0.3, 1, 0.6], intensity: 3, ambient: 0.05 };
+const opt = { size: 128, ssaa: 16, distances: [], files: [], fov: 30, pitch: 35, truth: null, light: [0.3, 1, 0.6], intensity: 3, ambient: 0.05, anisotropy: 1 };
 for (let i = 0; i < args.length; i++) {
   const a = args[i];
   const next = () => args[++i];
@@ -29,6 +29,7 @@ for (let i = 0; i < args.length; i++) {
   else if (a === '--light') opt.light = next().split(',').map(Number);
   else if (a === '--intensity') opt.intensity = +next();
   else if (a === '--json') opt.json = next();
+  else if (a === '--anisotropy') opt.anisotropy = +next();
   else if (a.includes('=')) {
     const [name, file] = a.split('=');
     opt.files.push({ name, file: path.resolve(file) });
@@ -84,7 +85,7 @@ const render = (k, distance, truth) => {
   const eye = [0, distance * Math.sin(p), distance * Math.cos(p)];
   return page.evaluate((cfg) => window.renderView(cfg), {
     url: url(k), truth, size: opt.size, ssaa: truth ? opt.ssaa : 1, fov: opt.fov, distance, eye, target: [0, 0, 0],
-    light: { dir: opt.light, intensity: opt.intensity }, ambient: opt.ambient,
+    light: { dir: opt.light, intensity: opt.intensity }, ambient: opt.ambient, anisotropy: opt.anisotropy,
   });
 };
 

@@ -29,6 +29,15 @@ function levelZeroOnly(root) {
 window.renderView = async (cfg) => {
   const gltf = await gltfLoader.loadAsync(cfg.url);
   if (cfg.truth) levelZeroOnly(gltf.scene);
+  // `--anisotropy N` (default 1, three.js's): every texture filtered anisotropically, up to what
+  // the context allows.
+  else if (cfg.anisotropy > 1) {
+    const n = Math.min(cfg.anisotropy, renderer.capabilities.getMaxAnisotropy());
+    gltf.scene.traverse((o) => {
+      if (!o.isMesh) return;
+      for (const key of ['normalMap', 'roughnessMap', 'metalnessMap']) if (o.material[key]) o.material[key].anisotropy = n;
+    });
+  }
   const scene = new THREE.Scene();
   scene.add(gltf.scene);
   const light = new THREE.DirectionalLight(0xffffff, cfg.light.intensity);
