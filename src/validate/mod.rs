@@ -295,28 +295,35 @@ pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
     } else {
         use crate::format::image::{self as img, Kind};
         let limits = img::Limits::file(crate::normalmap::DEFAULT_MAX_PIXELS);
-        let img = img::decode_within(&bytes, &limits).map_err(|e| match Kind::sniff(&bytes) {
-            Kind::Unknown => Error::input(
-                path,
-                format!("neither a mesh (.gltf, .glb, .obj) nor an image bumpbake reads ({})", img::DECODED),
-            ),
-            _ => Error::in_file(path, e),
-        })?;
+        // A KTX2 carries its own chain: decoded once, level 0 gets the image checks and the
+        // levels get the checks a material's KTX2 gets.
+        let chain = (Kind::sniff(&bytes) == Kind::Ktx2).then(|| img::ktx2::decode_levels_within(&bytes, &limits));
+        let decoded;
+        let level0 = match &chain {
+            Some(Ok(imgs)) => &imgs[0],
+            _ => {
+                decoded = img::decode_within(&bytes, &limits).map_err(|e| match Kind::sniff(&bytes) {
+                    Kind::Unknown => Error::input(
+                        path,
+                        format!("neither a mesh (.gltf, .glb, .obj) nor an image bumpbake reads ({})", img::DECODED),
+                    ),
+                    _ => Error::in_file(path, e),
+                })?;
+                &decoded
+            }
+        };
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let mut subject = Subject::new("image", name);
         let codec = lossy::Codec::sniff(&bytes);
-        validate_normal_image(&img, codec, opts.image_convention, "the command line", &mut subject);
-        // A KTX2 carries its own chain: its levels get the checks a material's KTX2 gets.
-        if Kind::sniff(&bytes) == Kind::Ktx2 {
-            drop(img);
-            match img::ktx2::decode_levels_within(&bytes, &limits) {
-                Ok(imgs) => mip_levels::check(&mip_levels::levels(&imgs), codec, &mut subject),
-                Err(e) => {
-                    let why = format!("mip levels not checked: {e}");
-                    let f = Finding::new(Code::NORMALMAP_UNREADABLE, 1, 1, "images", why);
-                    subject.check(Code::NORMALMAP_UNREADABLE, Some(f));
-                }
+        validate_normal_image(level0, codec, opts.image_convention, "the command line", &mut subject);
+        match &chain {
+            Some(Ok(imgs)) => mip_levels::check(&mip_levels::levels(imgs), codec, &mut subject),
+            Some(Err(e)) => {
+                let why = format!("mip levels not checked: {e}");
+                let f = Finding::new(Code::NORMALMAP_UNREADABLE, 1, 1, "images", why);
+                subject.check(Code::NORMALMAP_UNREADABLE, Some(f));
             }
+            None => {}
         }
         FileReport { path: path.to_path_buf(), kind: "image", subjects: vec![subject] }
     };
