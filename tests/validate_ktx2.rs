@@ -24,7 +24,7 @@ fn bumpy_map(n: u32) -> image::RgbImage {
 /// The chain as bumpbake builds it: every level from the level-0 unit normals, renormalised.
 fn good_chain(img: &image::RgbImage) -> Vec<mips::MipLevel> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    mips::build(&mips::unit_normals(img.as_raw()), w, h)
+    mips::build_rgb(img.as_raw(), w, h)
 }
 
 fn encode_levels(levels: &[(usize, usize, Vec<u8>)], codec: Codec) -> Vec<u8> {

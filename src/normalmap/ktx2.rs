@@ -38,7 +38,7 @@ pub fn ktx2_bytes(
     codec: Codec,
     t: &mut Timings,
 ) -> crate::error::Faulty<(Vec<u8>, Vec<LevelError>)> {
-    let levels: Vec<MipLevel> = t.time("mips", || mips::build(&mips::unit_normals(rgb), w, h));
+    let levels: Vec<MipLevel> = t.time("mips", || mips::build_rgb(rgb, w, h));
     let input: Vec<Level> =
         levels.iter().map(|l| Level { width: l.width as u32, height: l.height as u32, rgb: &l.rgb }).collect();
     let threads = rayon::current_num_threads() as u32;

@@ -85,8 +85,15 @@ pub fn unit_normals(rgb: &[u8]) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// Every level of the chain of a `w` x `h` map of unit normals (level 0 first). Level 0 is the
-/// input itself, encoded. Each texel is computed on its own in a fixed order, so the bytes do not
+/// The chain of an RGB8 normal map (`w` x `h`): [`build`] on its unit normals, with level 0 the
+/// map's own bytes. Re-rounding the renormalised texels would move some by a code: the encoder
+/// is given the map as it was made, as the Basis Universal command line is.
+pub fn build_rgb(rgb: &[u8], w: usize, h: usize) -> Vec<MipLevel> {
+    build_with(unit_normals(rgb), w, h, Some(rgb))
+}
+
+/// Every level of the chain of a `w` x `h` map of unit normals (level 0 first; renormalised
+/// first, so an ulp off unit does not matter). Level 0 is the input itself, encoded. Each texel is computed on its own in a fixed order, so the bytes do not
 /// depend on the number of threads.
 ///
 /// A level is kept as the weighted sums of the level-0 normals under each texel. Where a level's
@@ -95,16 +102,31 @@ pub fn unit_normals(rgb: &[u8]) -> Vec<[f32; 3]> {
 /// 4/3 of one pass over level 0 instead of one pass per level. Other levels are summed from
 /// level 0 with proportional footprints.
 pub fn build(normals: &[[f32; 3]], w: usize, h: usize) -> Vec<MipLevel> {
+    let unit = normals.par_iter().with_min_len(4096).map(|n| encode(n.map(f64::from)).1).collect();
+    build_with(unit, w, h, None)
+}
+
+/// The chain of `w` x `h` unit normals; level 0's bytes are `base_rgb`, or the normals rounded.
+fn build_with(normals: Vec<[f32; 3]>, w: usize, h: usize, base_rgb: Option<&[u8]>) -> Vec<MipLevel> {
     assert_eq!(normals.len(), w * h, "a plane of w x h normals");
-    let mut out = Vec::with_capacity(level_count(w, h));
+    let rgb = match base_rgb {
+        Some(b) => b.to_vec(),
+        None => normals.par_iter().with_min_len(4096).flat_map_iter(|n| n.map(quantize8)).collect(),
+    };
+    // Level 0: each texel's footprint is itself, so its mean normal has length 1 exactly (a unit
+    // normal's length in floating point can fall an ulp short, which specular antialiasing would
+    // read as variance and turn roughness 0 into 0.02).
+    let mut out = vec![MipLevel { width: w, height: h, rgb, ideal: normals, mean_length: vec![1.0; w * h] }];
+    let mut rest = Vec::with_capacity(level_count(w, h) - 1);
+    let normals = &out[0].ideal;
+    // The level above as sums; level 0's sums are its normals (footprints of one texel, weight 1).
     let mut above: Option<(Vec<[f64; 3]>, usize, usize)> = None;
-    for k in 0..level_count(w, h) {
+    for k in 1..level_count(w, h) {
         let (lw, lh) = (level_size(w, k), level_size(h, k));
         let area = (w as f64 / lw as f64) * (h as f64 / lh as f64);
         let sums = match &above {
             Some((s, pw, ph)) if pw % lw == 0 && ph % lh == 0 => sum_blocks(s, *pw, lw, lh, pw / lw, ph / lh),
-            // Level 0's footprints are its own texels at weight 1: the sums are the normals.
-            None => normals.par_iter().with_min_len(4096).map(|n| n.map(f64::from)).collect(),
+            None if w.is_multiple_of(lw) && h.is_multiple_of(lh) => sum_blocks(normals, w, lw, lh, w / lw, h / lh),
             _ => sum_footprints(normals, w, h, lw, lh),
         };
         let texels: Vec<Texel> = sums
@@ -127,14 +149,23 @@ pub fn build(normals: &[[f32; 3]], w: usize, h: usize) -> Vec<MipLevel> {
             level.ideal.push(ideal);
             level.mean_length.push(len);
         }
-        out.push(level);
+        rest.push(level);
         above = Some((sums, lw, lh));
     }
+    out.append(&mut rest);
     out
 }
 
-/// Sums of `rx` x `ry` blocks of a `pw`-wide plane of sums, into an `lw` x `lh` plane.
-fn sum_blocks(s: &[[f64; 3]], pw: usize, lw: usize, lh: usize, rx: usize, ry: usize) -> Vec<[f64; 3]> {
+/// Sums of `rx` x `ry` blocks of a `pw`-wide plane of sums (or of level 0's normals), into an
+/// `lw` x `lh` plane.
+fn sum_blocks<T: Copy + Into<f64> + Sync>(
+    s: &[[T; 3]],
+    pw: usize,
+    lw: usize,
+    lh: usize,
+    rx: usize,
+    ry: usize,
+) -> Vec<[f64; 3]> {
     (0..lw * lh)
         .into_par_iter()
         .with_min_len(1024)
@@ -143,9 +174,9 @@ fn sum_blocks(s: &[[f64; 3]], pw: usize, lw: usize, lh: usize, rx: usize, ry: us
             let mut t = [0.0f64; 3];
             for row in s[y * ry * pw..].chunks(pw).take(ry) {
                 for v in &row[x * rx..x * rx + rx] {
-                    t[0] += v[0];
-                    t[1] += v[1];
-                    t[2] += v[2];
+                    t[0] += v[0].into();
+                    t[1] += v[1].into();
+                    t[2] += v[2].into();
                 }
             }
             t
@@ -208,23 +239,31 @@ pub fn scalar_levels(plane: &[f32], w: usize, h: usize) -> Vec<Vec<f32>> {
 }
 
 /// Angles (degrees) between stored RGB8 texels and the ideal normals: mean and 99th percentile.
+///
+/// The angle is `atan2(|a x b|, a . b)`: it needs neither vector at unit length and keeps its
+/// precision at the small angles a codec makes, where `acos` of a dot product near 1 would not,
+/// so f32 (the precision of the inputs) is enough.
 pub fn angular_error(rgb: &[u8], ideal: &[[f32; 3]]) -> (f64, f64) {
-    let mut deg: Vec<f64> = unit_normals(rgb)
-        .par_iter()
+    let mut deg: Vec<f32> = rgb
+        .par_chunks_exact(3)
         .with_min_len(4096)
         .zip(ideal)
-        .map(|(a, b)| {
-            let d = a[0] as f64 * b[0] as f64 + a[1] as f64 * b[1] as f64 + a[2] as f64 * b[2] as f64;
-            d.clamp(-1.0, 1.0).acos().to_degrees()
+        .map(|(t, b)| {
+            let a = [decode8(t[0]), decode8(t[1]), decode8(t[2])];
+            let c = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+            let sin = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+            let cos = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            sin.atan2(cos).to_degrees()
         })
         .collect();
     if deg.is_empty() {
         return (0.0, 0.0);
     }
-    let mean = deg.iter().sum::<f64>() / deg.len() as f64;
+    // In order, so the figure does not depend on the thread count.
+    let mean = deg.iter().map(|&d| d as f64).sum::<f64>() / deg.len() as f64;
     let at = ((deg.len() as f64 * 0.99).ceil() as usize).clamp(1, deg.len()) - 1;
-    let (_, p99, _) = deg.select_nth_unstable_by(at, f64::total_cmp);
-    (mean, *p99)
+    let (_, p99, _) = deg.select_nth_unstable_by(at, f32::total_cmp);
+    (mean, *p99 as f64)
 }
 
 #[cfg(test)]
@@ -335,5 +374,18 @@ mod tests {
         let many = pool(4).install(|| build(&n, w, h));
         let one = pool(1).install(|| build(&n, w, h));
         assert_eq!(many, one);
+    }
+
+    /// Level 0 is the map's own bytes, though re-rounding its renormalised texels would move
+    /// them; the levels below are built from its unit normals all the same.
+    #[test]
+    fn a_map_keeps_its_own_level_0() {
+        // (200, 90, 230) decodes to length 1.07; renormalised it rounds to (196, 92, 224).
+        let rgb: Vec<u8> = [[200u8, 90, 230], [128, 128, 255], [30, 140, 200], [128, 60, 240]].concat();
+        let chain = build_rgb(&rgb, 2, 2);
+        assert_eq!(chain[0].rgb, rgb);
+        let rebuilt = build(&unit_normals(&rgb), 2, 2);
+        assert_ne!(rebuilt[0].rgb, rgb, "the sample does not re-round");
+        assert_eq!((&chain[0].ideal, &chain[1]), (&rebuilt[0].ideal, &rebuilt[1]));
     }
 }

@@ -146,4 +146,19 @@ mod tests {
         let want = ((0.2f32.powi(4) + 0.6f32.powi(4)) / 2.0).sqrt().sqrt();
         assert!((r[1].roughness[0] - want).abs() < 1e-6);
     }
+
+    /// A unit normal's length can fall an ulp short of 1; level 0 must not read that as spread,
+    /// or a mirror (roughness 0) would leave at 0.02.
+    #[test]
+    fn level_0_keeps_a_mirror_a_mirror() {
+        let rgb: Vec<u8> = (0..64 * 64u32).flat_map(|i| [(i * 37 % 256) as u8, (i * 91 % 256) as u8, 250]).collect();
+        let short = mips::unit_normals(&rgb).iter().any(|n| {
+            let l = n.iter().map(|&c| c as f64 * c as f64).sum::<f64>().sqrt();
+            (l as f32) < 1.0
+        });
+        assert!(short, "the sample has no unit normal an ulp short");
+        let r = roughness_levels(&mips::build_rgb(&rgb, 64, 64), &[0.0; 64 * 64], DEFAULT_THRESHOLD);
+        assert!(r[0].roughness.iter().all(|&v| v == 0.0));
+        assert!(r[1].roughness.iter().all(|&v| v > 0.0));
+    }
 }

@@ -132,7 +132,7 @@ fn decode(scene: &Scene, image: usize, bytes: &[u8]) -> Result<image::DynamicIma
 fn encode_normal(scene: &mut Scene, image: usize, bytes: &[u8], codec: Codec) -> Result<Encoded> {
     let rgb = decode(scene, image, bytes)?.to_rgb8();
     let (w, h) = (rgb.width() as usize, rgb.height() as usize);
-    let chain = mips::build(&mips::unit_normals(rgb.as_raw()), w, h);
+    let chain = mips::build_rgb(rgb.as_raw(), w, h);
     let levels: Vec<(usize, usize, &[u8])> = chain.iter().map(|l| (l.width, l.height, l.rgb.as_slice())).collect();
     let ktx = encode_levels(scene, &levels, codec)?;
     let errors = measure(&ktx, &chain).map_err(|e| Error::in_file(&scene.source, e))?;

@@ -1,9 +1,10 @@
 //! `bumpbake bench textures`: KTX2 normal maps with mips, every codec setting, side by side with
 //! the Basis Universal command line (`basisu`) on the same maps in the same run.
 //!
-//! Both tools get the same 8-bit normal map; both outputs are read back with bumpbake's KTX2
-//! decoder and measured against the same ideal levels (`mips.rs`: the renormalised average of
-//! the full-resolution normals under each texel), so the error columns compare like with like.
+//! Both tools read the same 8-bit normal map from the same PNG file and are timed from that read
+//! to the KTX2 written. Both outputs are read back with bumpbake's KTX2 decoder and measured
+//! against the same ideal levels (`mips.rs`: the renormalised average of the full-resolution
+//! normals under each texel), so the error columns compare like with like.
 
 mod report;
 
@@ -110,7 +111,7 @@ pub struct Run {
     pub cpu_median_s: Option<f64>,
     pub bytes: usize,
     pub levels: Vec<LevelStat>,
-    /// bumpbake only: median of each stage, ms (mips, encode, check).
+    /// bumpbake only: median of each stage, ms (read, mips, encode, check).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub stages_ms: Vec<(String, f64)>,
 }
@@ -123,6 +124,11 @@ pub struct Row {
     pub basisu: Run,
     /// bumpbake's median time over basisu's (below 1: bumpbake is faster).
     pub time_ratio: f64,
+    /// The median of each run's ratio, bumpbake's time over basisu's run right after it: less
+    /// moved by load that drifts over the bench than the ratio of medians.
+    pub paired_time_ratio: f64,
+    /// Every run's time, s, in the order run (bumpbake, basisu).
+    pub runs_s: Vec<(f64, f64)>,
     /// The same for CPU time: the work, without the neighbours' load.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cpu_ratio: Option<f64>,
@@ -202,7 +208,7 @@ fn measure(exe: &Path, dir: &Path, sizes: &[usize], settings: &[Codec], runs: us
             .expect("n*n*3 bytes")
             .save(&png)
             .map_err(|e| Error::output(&png, std::io::Error::other(e.to_string())))?;
-        let levels = mips::build(&mips::unit_normals(&rgb), n, n);
+        let levels = mips::build_rgb(&rgb, n, n);
         for &c in settings {
             eprintln!("bench: {n}x{n} {}", setting_name(c));
             rows.push(one(exe, dir, &png, &rgb, n, &levels, c, runs)?);
@@ -239,8 +245,11 @@ fn one(
     for _ in 0..runs {
         let (t0, c0) = (Instant::now(), cpu_seconds());
         let mut t = Timings::default();
+        // From the same PNG file basisu reads, so both times include decoding it.
+        let img = t.time("read", || image::open(png)).map_err(|e| Error::input(png, e.to_string()))?.to_rgb8();
+        debug_assert!(img.as_raw() == rgb);
         let (bytes, report) =
-            nm::ktx2_bytes(rgb, n, n, c, &mut t).map_err(|e| Error::usage(format!("bench textures: {e}")))?;
+            nm::ktx2_bytes(img.as_raw(), n, n, c, &mut t).map_err(|e| Error::usage(format!("bench textures: {e}")))?;
         bumpbake::output::write_atomic(&out_ours, &bytes)?;
         ours_t.push(t0.elapsed().as_secs_f64());
         ours_cpu.push(c0.zip(cpu_seconds()).map(|(a, b)| b.0 - a.0));
@@ -264,6 +273,8 @@ fn one(
         }
     }
     let (bytes, report) = ours.expect("at least one run");
+    let runs_s: Vec<(f64, f64)> = ours_t.iter().copied().zip(theirs_t.iter().copied()).collect();
+    let mut paired: Vec<f64> = runs_s.iter().map(|(a, b)| a / b.max(1e-9)).collect();
     let theirs = std::fs::read(&out_theirs).map_err(|e| Error::input(&out_theirs, format!("cannot read: {e}")))?;
     let theirs_err =
         nm::measure(&theirs, levels).map_err(|e| Error::usage(format!("bench textures: basisu's output: {e}")))?;
@@ -277,6 +288,8 @@ fn one(
         size: n,
         setting: setting_name(c),
         time_ratio: bumpbake.median_s / basisu.median_s.max(1e-9),
+        paired_time_ratio: median(&mut paired),
+        runs_s,
         cpu_ratio: bumpbake.cpu_median_s.zip(basisu.cpu_median_s).filter(|(_, b)| *b > 0.0).map(|(a, b)| a / b),
         size_ratio: bumpbake.bytes as f64 / basisu.bytes.max(1) as f64,
         worst_mean_excess_deg: excess(|l| l.mean_deg),

@@ -52,6 +52,7 @@ pub fn render_text(r: &Report) -> String {
         }
         let stages: Vec<String> = row.bumpbake.stages_ms.iter().map(|(n, ms)| format!("{n} {ms:.0}")).collect();
         let _ = writeln!(s, "bumpbake stages (ms): {}", stages.join(", "));
+        let _ = writeln!(s, "median of the runs' own time ratios: {:.3}", row.paired_time_ratio);
         if let (Some(a), Some(b), Some(r)) = (row.bumpbake.cpu_median_s, row.basisu.cpu_median_s, row.cpu_ratio) {
             let _ = writeln!(s, "CPU time, median s: bumpbake {a:.2}, basisu {b:.2}, ratio {r:.3}");
         }
@@ -115,6 +116,8 @@ mod tests {
             bumpbake: run(1.5, 0.25),
             basisu: run(3.0, 0.5),
             time_ratio: 0.5,
+            paired_time_ratio: 0.45,
+            runs_s: vec![(1.5, 3.0)],
             cpu_ratio: None,
             size_ratio: 1.0,
             worst_mean_excess_deg: -0.25,
@@ -131,6 +134,7 @@ mod tests {
         let t = super::render_text(&r);
         assert!(t.contains("| 256 | uastc2 | 1.50 | 3.00 | 0.50 | 1000 | 1000 | 1.00 | 0.250 / 0.500 |"), "{t}");
         assert!(t.contains("| 0 | 0.250 / 0.500 | 0.500 / 1.000 |"), "{t}");
+        assert!(t.contains("time ratios: 0.450"), "{t}");
         let svg = super::error_vs_time_svg(&r);
         assert_eq!(svg.matches("<circle").count(), 2 + 2, "two points and two legend entries");
         assert!(svg.contains("bumpbake 256²") && svg.contains(">uastc2</text>"));

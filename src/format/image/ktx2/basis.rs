@@ -154,9 +154,29 @@ fn transcode(file: &[u8], w: u32, h: u32) -> crate::error::Faulty<Vec<u8>> {
 
 /// UASTC blocks (already out of any Zstandard) to RGBA8. `alpha`: the file's alpha channel
 /// carries data (RGBA, or a two-channel map's y).
+/// UASTC blocks are independent, so a large level is cut into bands of block rows and the bands
+/// transcoded on every core; the pixels are the same as one call's.
 pub(super) fn uastc(blocks: &[u8], w: u32, h: u32, alpha: bool) -> crate::error::Faulty<Vec<u8>> {
-    let file = basis_file(false, w, h, &Codebooks::default(), &[Slice { alpha, data: blocks }])?;
-    transcode(&file, w, h)
+    use rayon::prelude::*;
+    const BLOCK: usize = 16;
+    const BAND_BLOCKS: usize = 8192;
+    let row = w.div_ceil(4) as usize * BLOCK;
+    let rows = h.div_ceil(4) as usize;
+    let band_rows = (BAND_BLOCKS * BLOCK / row.max(1)).max(1);
+    if rows <= band_rows || blocks.len() != row * rows {
+        let file = basis_file(false, w, h, &Codebooks::default(), &[Slice { alpha, data: blocks }])?;
+        return transcode(&file, w, h);
+    }
+    let bands = blocks
+        .par_chunks(band_rows * row)
+        .enumerate()
+        .map(|(i, data)| {
+            let bh = (h - (i * band_rows * 4) as u32).min((band_rows * 4) as u32);
+            let file = basis_file(false, w, bh, &Codebooks::default(), &[Slice { alpha, data }])?;
+            transcode(&file, w, bh)
+        })
+        .collect::<crate::error::Faulty<Vec<_>>>()?;
+    Ok(bands.concat())
 }
 
 pub(super) fn u16_at(b: &[u8], at: usize) -> u16 {
@@ -222,6 +242,13 @@ pub(super) fn etc1s(
 
 #[cfg(test)]
 pub(super) mod tests_support {
+    /// The one-call transcode `uastc` cuts into bands.
+    pub fn uastc_whole(blocks: &[u8], w: u32, h: u32) -> Vec<u8> {
+        let slice = super::Slice { alpha: false, data: blocks };
+        super::transcode(&super::basis_file(false, w, h, &super::Codebooks::default(), &[slice]).unwrap(), w, h)
+            .unwrap()
+    }
+
     /// A `.basis` file of `w` x `h` zero UASTC blocks.
     pub fn empty_uastc(w: u32, h: u32) -> Vec<u8> {
         let blocks = vec![0u8; (w.div_ceil(4) * h.div_ceil(4) * 16) as usize];

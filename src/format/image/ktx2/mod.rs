@@ -24,12 +24,20 @@
 //! holds, and every malformed file is one line of words.
 
 mod basis;
+mod uastc;
 mod write;
 
-pub use write::{encode, Codec, Level, MAX_SIDE};
+pub use write::{encode, Codec, MAX_SIDE};
 
 use super::{check_size_within, Limits};
 use image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgba};
+
+/// One level to encode: RGB8 texels, row-major from the top row.
+pub struct Level<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: &'a [u8],
+}
 
 /// How a KTX2 file stores its base level, as far as bumpbake is concerned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,10 +7,12 @@
 //! libzstd at basisu's level, see docs/dependencies.md), and for ETC1S its codebooks and tables
 //! become the supercompression global data.
 //!
-//! The levels are handed to the encoder as user mipmaps (`m_source_mipmap_images`), with its own
-//! mipmap generation off: what is stored is what the caller built.
+//! Plain UASTC is encoded block by block (`uastc.rs`). For RDO and ETC1S the levels are handed to
+//! the encoder's compressor as user mipmaps (`m_source_mipmap_images`), with its own mipmap
+//! generation off: what is stored is what the caller built.
 
 use basis_universal::{BasisTextureFormat, ColorSpace, Compressor, CompressorParams};
+use rayon::prelude::*;
 
 /// The Basis Universal codec and its quality.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -23,18 +25,11 @@ pub enum Codec {
     Etc1s { quality: u32 },
 }
 
-/// One level of RGB8 texels, row-major from the top row.
-pub struct Level<'a> {
-    pub width: u32,
-    pub height: u32,
-    pub rgb: &'a [u8],
-}
-
 /// The largest side the Basis Universal encoder takes (`BASISU_MAX_SUPPORTED_TEXTURE_DIMENSION`).
 pub const MAX_SIDE: u32 = 16384;
 
 use super::basis::{u16_at, u24_at, u32_at, HEADER, SLICE};
-use super::{BASIS_LZ, ZSTD};
+use super::{Level, BASIS_LZ, ZSTD};
 /// basisu's own Zstandard level for UASTC (`-ktx2_zstandard_level`, default 6).
 const ZSTD_LEVEL: i32 = 6;
 /// The encoder splits its RDO pass into `min(4, threads)` runs, each with its own dictionary, so
@@ -150,38 +145,50 @@ pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Fau
             return Err(format!("a {}x{} level with {} bytes of RGB", l.width, l.height, l.rgb.len()).into());
         }
     }
-    let basis = basis_file(levels, codec, threads)?;
     let n = levels.len();
-    let parts = slices(&basis, n)?;
     let uastc = matches!(codec, Codec::Uastc { .. });
-    let (data, sgd): (Vec<Vec<u8>>, Vec<u8>) = if uastc {
-        let data = parts
-            .iter()
-            .map(|&(o, l)| zstd::bulk::compress(&basis[o..o + l], ZSTD_LEVEL))
-            .collect::<std::io::Result<Vec<_>>>()
-            .map_err(|e| format!("Zstandard failed: {e}"))?;
-        (data, Vec::new())
-    } else {
-        let (ep_ofs, ep_len) = (u32_at(&basis, 41), u24_at(&basis, 45));
-        let (sel_ofs, sel_len) = (u32_at(&basis, 50), u24_at(&basis, 54));
-        let (tab_ofs, tab_len) = (u32_at(&basis, 57), u32_at(&basis, 61));
-        let within = |o: usize, l: usize| basis.get(o..o + l).ok_or("the encoder's codebooks lie outside its file");
-        let mut g = Vec::new();
-        g.extend_from_slice(&u16_at(&basis, 39).to_le_bytes());
-        g.extend_from_slice(&u16_at(&basis, 48).to_le_bytes());
-        for v in [ep_len, sel_len, tab_len, 0] {
-            g.extend_from_slice(&(v as u32).to_le_bytes());
+    // Per level: the stored bytes and, for UASTC, the blocks' length before Zstandard.
+    let (data, raw, sgd): (Vec<Vec<u8>>, Vec<usize>, Vec<u8>) = match codec {
+        Codec::Uastc { level, rdo } => {
+            let blocks = match rdo {
+                None => super::uastc::encode(levels, level),
+                Some(_) => {
+                    let basis = basis_file(levels, codec, threads)?;
+                    slices(&basis, n)?.iter().map(|&(o, l)| basis[o..o + l].to_vec()).collect()
+                }
+            };
+            let data = blocks
+                .par_iter()
+                .map(|b| zstd::bulk::compress(b, ZSTD_LEVEL))
+                .collect::<std::io::Result<Vec<_>>>()
+                .map_err(|e| format!("Zstandard failed: {e}"))?;
+            (data, blocks.iter().map(Vec::len).collect(), Vec::new())
         }
-        for &(_, l) in &parts {
-            // Flags 0 (an I-frame), RGB slice the whole level, no alpha slice.
-            for v in [0u32, 0, l as u32, 0, 0] {
-                g.extend_from_slice(&v.to_le_bytes());
+        Codec::Etc1s { .. } => {
+            let basis = basis_file(levels, codec, threads)?;
+            let parts = slices(&basis, n)?;
+            let (ep_ofs, ep_len) = (u32_at(&basis, 41), u24_at(&basis, 45));
+            let (sel_ofs, sel_len) = (u32_at(&basis, 50), u24_at(&basis, 54));
+            let (tab_ofs, tab_len) = (u32_at(&basis, 57), u32_at(&basis, 61));
+            let within = |o: usize, l: usize| basis.get(o..o + l).ok_or("the encoder's codebooks lie outside its file");
+            let mut g = Vec::new();
+            g.extend_from_slice(&u16_at(&basis, 39).to_le_bytes());
+            g.extend_from_slice(&u16_at(&basis, 48).to_le_bytes());
+            for v in [ep_len, sel_len, tab_len, 0] {
+                g.extend_from_slice(&(v as u32).to_le_bytes());
             }
+            for &(_, l) in &parts {
+                // Flags 0 (an I-frame), RGB slice the whole level, no alpha slice.
+                for v in [0u32, 0, l as u32, 0, 0] {
+                    g.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+            g.extend_from_slice(within(ep_ofs, ep_len)?);
+            g.extend_from_slice(within(sel_ofs, sel_len)?);
+            g.extend_from_slice(within(tab_ofs, tab_len)?);
+            // BasisLZ levels declare no uncompressed length.
+            (parts.iter().map(|&(o, l)| basis[o..o + l].to_vec()).collect(), vec![0; n], g)
         }
-        g.extend_from_slice(within(ep_ofs, ep_len)?);
-        g.extend_from_slice(within(sel_ofs, sel_len)?);
-        g.extend_from_slice(within(tab_ofs, tab_len)?);
-        (parts.iter().map(|&(o, l)| basis[o..o + l].to_vec()).collect(), g)
     };
     let dfd = dfd(uastc);
     let kvd = kvd();
@@ -209,9 +216,7 @@ pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Fau
     f.extend_from_slice(&(sgd_ofs as u64).to_le_bytes());
     f.extend_from_slice(&(sgd.len() as u64).to_le_bytes());
     for k in 0..n {
-        // BasisLZ levels declare no uncompressed length; UASTC's is its blocks.
-        let raw = if uastc { parts[k].1 } else { 0 };
-        for v in [offsets[k], data[k].len(), raw] {
+        for v in [offsets[k], data[k].len(), raw[k]] {
             f.extend_from_slice(&(v as u64).to_le_bytes());
         }
     }
@@ -231,6 +236,36 @@ pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Fau
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The block-by-block encoder (`uastc.rs`) gives the compressor's bytes, on levels whose
+    /// sides are not multiples of 4 and on rows with repeated (flat) blocks.
+    #[test]
+    fn plain_uastc_blocks_are_the_compressors() {
+        let texels = |w: u32, h: u32| -> Vec<u8> {
+            (0..w * h)
+                .flat_map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    // The left half flat, the right half a pattern that changes in every texel.
+                    if x < w / 2 {
+                        [128, 128, 255]
+                    } else {
+                        [(x * 29 + y * 7) as u8, (x * y * 3 + 50) as u8, (200 + (x ^ y) % 55) as u8]
+                    }
+                })
+                .collect()
+        };
+        let sizes: Vec<(u32, u32)> = vec![(37, 23), (18, 11), (9, 5), (4, 2), (2, 1), (1, 1)];
+        let maps: Vec<Vec<u8>> = sizes.iter().map(|&(w, h)| texels(w, h)).collect();
+        let levels: Vec<Level> =
+            sizes.iter().zip(&maps).map(|(&(width, height), rgb)| Level { width, height, rgb }).collect();
+        for level in 0..=2 {
+            let basis = basis_file(&levels, Codec::Uastc { level, rdo: None }, 2).unwrap();
+            let theirs: Vec<&[u8]> =
+                slices(&basis, levels.len()).unwrap().iter().map(|&(o, l)| &basis[o..o + l]).collect();
+            let ours = super::super::uastc::encode(&levels, level);
+            assert!(ours.iter().map(Vec::as_slice).eq(theirs), "pack level {level}");
+        }
+    }
 
     /// RDO splits its pass by thread count below 4; the bytes must not follow the machine.
     #[test]
