@@ -154,6 +154,7 @@ fn transcode(file: &[u8], w: u32, h: u32) -> crate::error::Faulty<Vec<u8>> {
 
 /// UASTC blocks (already out of any Zstandard) to RGBA8. `alpha`: the file's alpha channel
 /// carries data (RGBA, or a two-channel map's y).
+///
 /// UASTC blocks are independent, so a large level is cut into bands of block rows and the bands
 /// transcoded on every core; the pixels are the same as one call's.
 pub(super) fn uastc(blocks: &[u8], w: u32, h: u32, alpha: bool) -> crate::error::Faulty<Vec<u8>> {

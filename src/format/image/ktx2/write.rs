@@ -131,7 +131,8 @@ fn kvd() -> Vec<u8> {
 }
 
 /// A KTX2 file of `levels` (level 0 first, each half the one before as KTX2 sizes them).
-/// `threads`: the encoder's; the bytes do not depend on it.
+/// `threads`: the compressor's (RDO and ETC1S; plain UASTC runs on rayon's pool); the bytes do
+/// not depend on it.
 pub fn encode(levels: &[Level], codec: Codec, threads: u32) -> crate::error::Faulty<Vec<u8>> {
     if let Some(l) = levels.first().filter(|l| l.width > MAX_SIDE || l.height > MAX_SIDE) {
         return Err(format!(
