@@ -91,7 +91,7 @@ fn bake_ktx2_holds_the_chain_and_the_widened_roughness() {
     }
     assert_eq!(rep["textures"]["materials"][0]["levels"].as_array().unwrap().len(), levels.len());
 
-    // The roughness: roughnessFactor x 1 at level 0, widened above, within UASTC's error.
+    // The roughness: roughnessFactor x 1 at level 0, widened above, within rounding and UASTC's error.
     let old = png.pbr_factors(0);
     let now = ktx.pbr_factors(0);
     assert_eq!((now.roughness, now.metallic), (1.0, old.metallic));
@@ -103,7 +103,12 @@ fn bake_ktx2_holds_the_chain_and_the_widened_roughness() {
     for (k, (g, wl)) in got.iter().zip(&want).enumerate() {
         let d: Vec<f32> = g.pixels().zip(&wl.roughness).map(|(p, r)| (p[1] as f32 / 255.0 - r).abs()).collect();
         let mean = d.iter().sum::<f32>() / d.len() as f32;
-        assert!(mean < 2.0 / 255.0, "level {k}: roughness off by {mean} on average");
+        let max = d.iter().copied().fold(0.0f32, f32::max);
+        // Rounding to 8 bits and the codec (UASTC pack level 0 for a chain of factors alone).
+        assert!(
+            mean < 1.0 / 255.0 && max < 2.0 / 255.0,
+            "level {k}: roughness off by {mean} on average, {max} at most"
+        );
         assert!(g.pixels().all(|p| p[2] == 255), "level {k}: metalness kept (factors only: B = 255)");
         widened |= wl.roughness.iter().any(|&r| r > old.roughness + 0.02);
     }
