@@ -6,7 +6,7 @@
 //! `bake --textures ktx2` runs [`ship`] on its scene before writing; `bumpbake textures` runs
 //! [`run`] on files other tools wrote.
 
-mod roughness;
+pub mod roughness;
 
 use crate::error::{Error, Result};
 use crate::format::image::ktx2::{self, Codec, Level};

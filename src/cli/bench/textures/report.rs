@@ -17,6 +17,9 @@ pub fn render_text(r: &Report) -> String {
         "KTX2 normal maps with mips: bumpbake against {} ({}), {} threads, medians of {} interleaved runs\nmap: {}\n",
         r.basisu, r.basisu_version, r.threads, r.runs, r.map
     );
+    if let Some(f) = r.specular_aa {
+        let _ = writeln!(s, "bumpbake's times include the specular-AA roughness texture (roughness factor {f})\n");
+    }
     let _ = writeln!(
         s,
         "| size | setting | bumpbake s | basisu s | time ratio | bumpbake bytes | basisu bytes | size ratio | level 0 mean ° (ours / basisu) | worst level mean ° (ours / basisu) | worst excess mean / p99 ° |"
@@ -129,6 +132,7 @@ mod tests {
             threads: 2,
             basisu: "basisu".into(),
             basisu_version: "v1.16.3".into(),
+            specular_aa: None,
             rows: vec![row],
         };
         let t = super::render_text(&r);
