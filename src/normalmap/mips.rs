@@ -89,12 +89,12 @@ pub fn unit_normals(rgb: &[u8]) -> Vec<[f32; 3]> {
 /// map's own bytes. Re-rounding the renormalised texels would move some by a code: the encoder
 /// is given the map as it was made, as the Basis Universal command line is.
 pub fn build_rgb(rgb: &[u8], w: usize, h: usize) -> Vec<MipLevel> {
-    build_with(unit_normals(rgb), w, h, Some(rgb))
+    build_with(unit_normals(rgb), rgb.to_vec(), w, h)
 }
 
 /// Every level of the chain of a `w` x `h` map of unit normals (level 0 first; renormalised
-/// first, so an ulp off unit does not matter). Level 0 is the input itself, encoded. Each texel is computed on its own in a fixed order, so the bytes do not
-/// depend on the number of threads.
+/// first, so an ulp off unit does not matter). Level 0 is the input itself, encoded. Each texel
+/// is computed on its own in a fixed order, so the bytes do not depend on the number of threads.
 ///
 /// A level is kept as the weighted sums of the level-0 normals under each texel. Where a level's
 /// side divides the one above it (every level of a power-of-two map), each footprint is exactly
@@ -102,23 +102,20 @@ pub fn build_rgb(rgb: &[u8], w: usize, h: usize) -> Vec<MipLevel> {
 /// 4/3 of one pass over level 0 instead of one pass per level. Other levels are summed from
 /// level 0 with proportional footprints.
 pub fn build(normals: &[[f32; 3]], w: usize, h: usize) -> Vec<MipLevel> {
-    let unit = normals.par_iter().with_min_len(4096).map(|n| encode(n.map(f64::from)).1).collect();
-    build_with(unit, w, h, None)
+    let (rgb, unit): (Vec<[u8; 3]>, Vec<[f32; 3]>) =
+        normals.par_iter().with_min_len(4096).map(|n| encode(n.map(f64::from))).map(|(c, u, _)| (c, u)).unzip();
+    build_with(unit, rgb.concat(), w, h)
 }
 
-/// The chain of `w` x `h` unit normals; level 0's bytes are `base_rgb`, or the normals rounded.
-fn build_with(normals: Vec<[f32; 3]>, w: usize, h: usize, base_rgb: Option<&[u8]>) -> Vec<MipLevel> {
+/// The chain of `w` x `h` unit normals whose level 0 is stored as `rgb`.
+fn build_with(normals: Vec<[f32; 3]>, rgb: Vec<u8>, w: usize, h: usize) -> Vec<MipLevel> {
     assert_eq!(normals.len(), w * h, "a plane of w x h normals");
-    let rgb = match base_rgb {
-        Some(b) => b.to_vec(),
-        None => normals.par_iter().with_min_len(4096).flat_map_iter(|n| n.map(quantize8)).collect(),
-    };
     // Level 0: each texel's footprint is itself, so its mean normal has length 1 exactly (a unit
     // normal's length in floating point can fall an ulp short, which specular antialiasing would
     // read as variance and turn roughness 0 into 0.02).
-    let mut out = vec![MipLevel { width: w, height: h, rgb, ideal: normals, mean_length: vec![1.0; w * h] }];
-    let mut rest = Vec::with_capacity(level_count(w, h) - 1);
-    let normals = &out[0].ideal;
+    let base = MipLevel { width: w, height: h, rgb, ideal: normals, mean_length: vec![1.0; w * h] };
+    let normals = &base.ideal;
+    let mut out = Vec::with_capacity(level_count(w, h));
     // The level above as sums; level 0's sums are its normals (footprints of one texel, weight 1).
     let mut above: Option<(Vec<[f64; 3]>, usize, usize)> = None;
     for k in 1..level_count(w, h) {
@@ -149,10 +146,10 @@ fn build_with(normals: Vec<[f32; 3]>, w: usize, h: usize, base_rgb: Option<&[u8]
             level.ideal.push(ideal);
             level.mean_length.push(len);
         }
-        rest.push(level);
+        out.push(level);
         above = Some((sums, lw, lh));
     }
-    out.append(&mut rest);
+    out.insert(0, base);
     out
 }
 

@@ -106,11 +106,16 @@ struct Encoded {
     bytes: usize,
 }
 
-/// The KTX2 of RGB8 `levels`.
-fn encode_levels(scene: &Scene, levels: &[(usize, usize, &[u8])], codec: Codec) -> Result<Vec<u8>> {
+/// The KTX2 of RGB8 `levels` (width, height, texels).
+fn ktx2_of(levels: &[(usize, usize, &[u8])], codec: Codec) -> crate::error::Faulty<Vec<u8>> {
     let input: Vec<Level> =
         levels.iter().map(|&(w, h, rgb)| Level { width: w as u32, height: h as u32, rgb }).collect();
-    ktx2::encode(&input, codec, rayon::current_num_threads() as u32).map_err(|e| Error::in_file(&scene.source, e))
+    ktx2::encode(&input, codec, rayon::current_num_threads() as u32)
+}
+
+/// [`ktx2_of`], its failure named by the scene's file.
+fn encode_levels(scene: &Scene, levels: &[(usize, usize, &[u8])], codec: Codec) -> Result<Vec<u8>> {
+    ktx2_of(levels, codec).map_err(|e| Error::in_file(&scene.source, e))
 }
 
 /// The first of the texture's images bumpbake decodes, its plain `source` first: a PNG holds

@@ -7,9 +7,9 @@
 //! map's texel centres; it must be read through the same UV set and transform as the normal
 //! texture, or its texels do not correspond and the material is left as it was.
 
-use super::{decodable, decode, encode_levels, RoughnessReport, ShipOptions};
+use super::{decodable, decode, encode_levels, ktx2_of, RoughnessReport, ShipOptions};
 use crate::error::{Error, Result};
-use crate::format::image::ktx2::{self, Codec, Level};
+use crate::format::image::ktx2::Codec;
 use crate::normalmap::mips::{self, MipLevel};
 use crate::normalmap::specular_aa::{added, roughness_levels, RoughnessLevel};
 use crate::normalmap::DEFAULT_UASTC_LEVEL;
@@ -67,15 +67,14 @@ pub fn factors_only_ktx2(
     threshold: f32,
     normal_codec: Codec,
 ) -> crate::error::Faulty<Vec<u8>> {
-    let (w, h) = (normal[0].width, normal[0].height);
-    let ones = Planes { r: vec![1.0; w * h], g: vec![1.0; w * h], b: vec![1.0; w * h] };
+    let ones = Planes::ones(normal[0].width * normal[0].height);
     let (levels, rgb) = widened_chain(normal, &ones, roughness_factor.clamp(0.0, 1.0), threshold);
-    let input: Vec<Level> = levels
-        .iter()
-        .zip(&rgb)
-        .map(|(l, t)| Level { width: l.width as u32, height: l.height as u32, rgb: t })
-        .collect();
-    ktx2::encode(&input, codec_for(normal_codec, false), rayon::current_num_threads() as u32)
+    ktx2_of(&as_chain(&levels, &rgb), codec_for(normal_codec, false))
+}
+
+/// (width, height, texels) of each widened level.
+fn as_chain<'a>(levels: &[RoughnessLevel], rgb: &'a [Vec<u8>]) -> Vec<(usize, usize, &'a [u8])> {
+    levels.iter().zip(rgb).map(|(l, rgb)| (l.width, l.height, rgb.as_slice())).collect()
 }
 
 /// A material's new texture, and what it replaced (for dropping once nothing else shows it).
@@ -90,6 +89,12 @@ struct Planes {
     r: Vec<f32>,
     g: Vec<f32>,
     b: Vec<f32>,
+}
+
+impl Planes {
+    fn ones(n: usize) -> Planes {
+        Planes { r: vec![1.0; n], g: vec![1.0; n], b: vec![1.0; n] }
+    }
 }
 
 /// Bilinear at the destination texel centres, edges clamped. At equal sizes every centre falls
@@ -168,14 +173,11 @@ pub(super) fn widen_material(
         },
         // Factors only: metalness 1 (times the factor, unchanged), roughness 1 (times the factor,
         // moved into G below); R is unread.
-        None => Planes { r: vec![1.0; w * h], g: vec![1.0; w * h], b: vec![1.0; w * h] },
+        None => Planes::ones(w * h),
     };
     let factor = scene.pbr_factors(m).roughness.clamp(0.0, 1.0);
     let (levels, rgb) = widened_chain(normal, &planes, factor, opts.threshold);
-    let chain: Vec<(usize, usize, &[u8])> =
-        levels.iter().zip(&rgb).map(|(l, rgb)| (l.width, l.height, rgb.as_slice())).collect();
-    let codec = codec_for(opts.codec, mr.is_some());
-    let ktx = encode_levels(scene, &chain, codec)?;
+    let ktx = encode_levels(scene, &as_chain(&levels, &rgb), codec_for(opts.codec, mr.is_some()))?;
     let name = info.as_ref().and_then(|i| i.name.clone()).unwrap_or_else(|| format!("material{m}"));
     let name = format!("{name}_metallicRoughness");
     let image = scene.push_image(&ktx, "image/ktx2", Some(&name));
