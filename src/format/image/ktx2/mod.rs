@@ -24,6 +24,7 @@
 //! holds, and every malformed file is one line of words.
 
 mod basis;
+mod etc1_hints;
 mod uastc;
 mod write;
 
