@@ -73,6 +73,19 @@ pub(super) const LEVELS: std::ops::RangeInclusive<u32> = 2..=4;
 /// `decoded` the UASTC block's own pixels (both RGBA, row by row), `has_bias` whether the block's
 /// mode stores a bias, `level` the pack level (in [`LEVELS`]).
 pub(super) fn hints(source: &[[u8; 4]; 16], decoded: &[[u8; 4]; 16], has_bias: bool, level: u32) -> Hints {
+    search(source, decoded, has_bias, level, true)
+}
+
+/// Whether this CPU runs AVX2.
+fn avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    return false;
+}
+
+/// [`hints`], with the AVX2 build of the inner loop where `wide` and the CPU allows it.
+fn search(source: &[[u8; 4]; 16], decoded: &[[u8; 4]; 16], has_bias: bool, level: u32, wide: bool) -> Hints {
     debug_assert!(LEVELS.contains(&level));
     let biases: &[u8] = match (has_bias, level) {
         (false, _) => &[0],
@@ -84,7 +97,7 @@ pub(super) fn hints(source: &[[u8; 4]; 16], decoded: &[[u8; 4]; 16], has_bias: b
     let mut best = Hints { flip: false, diff: false, inten: [0, 0], bias: 0 };
     let mut best_err = u64::MAX;
     for flip in [0, 1] {
-        let mut subs = [0, 1].map(|s| Subblock::new(source, decoded, flip, s, all_tables));
+        let mut subs = [0, 1].map(|s| Subblock::new(source, decoded, flip, s, all_tables, wide));
         for individual in [false, true] {
             let mul = if individual { 15 } else { 31 };
             let unbiased = [0, 1].map(|s| subs[s].mean(mul));
@@ -225,6 +238,8 @@ struct Subblock {
     min: [i32; 3],
     max: [i32; 3],
     all_tables: bool,
+    /// Whether to run the AVX2 build of [`Self::eval`].
+    wide: bool,
     /// The encoder stops trying tables at the first that is no better when the subblocks are
     /// columns (flip 0), and tries them all when they are rows.
     greedy: bool,
@@ -235,7 +250,14 @@ struct Subblock {
 }
 
 impl Subblock {
-    fn new(source: &[[u8; 4]; 16], decoded: &[[u8; 4]; 16], flip: usize, s: usize, all_tables: bool) -> Subblock {
+    fn new(
+        source: &[[u8; 4]; 16],
+        decoded: &[[u8; 4]; 16],
+        flip: usize,
+        s: usize,
+        all_tables: bool,
+        wide: bool,
+    ) -> Subblock {
         // Flip 0 splits into left and right columns, flip 1 into top and bottom rows.
         let index = |j: usize| if flip == 0 { (j % 4) * 4 + 2 * s + j / 4 } else { (2 * s + j / 4) * 4 + j % 4 };
         let ycc = |p: [u8; 4]| Ycc::of(p[0] as i32, p[1] as i32, p[2] as i32);
@@ -256,6 +278,7 @@ impl Subblock {
             min,
             max,
             all_tables,
+            wide: wide && avx2(),
             greedy: flip == 0,
             seen: [(0, 0, 0); 64],
             tried: 0,
@@ -271,8 +294,8 @@ impl Subblock {
     /// error of that table against the source pixels.
     fn eval(&mut self, base: [i32; 3]) -> (u8, u64) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2, checked on the line above.
+        if self.wide {
+            // SAFETY: `wide` is set only where the CPU has AVX2 (`Subblock::new`).
             return unsafe { self.eval_avx2(base) };
         }
         self.eval_here(base)
@@ -356,4 +379,39 @@ impl Subblock {
 /// The four colours of a table on a base colour, each channel clamped.
 fn entries(base: [i32; 3], m: &[i32; 4]) -> [Ycc; 4] {
     m.map(|mk| Ycc::of(clamp255(base[0] + mk), clamp255(base[1] + mk), clamp255(base[2] + mk)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX2 and the plain build give the same hints (the encoder's: `uastc.rs`'s tests), on
+    /// blocks from smooth to noisy, normal-map blue (tables clamp) and not.
+    #[test]
+    fn both_builds_agree() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for i in 0..600 {
+            let spread = [4, 24, 96, 255][i % 4];
+            let (base, blue_high) = (next(), i % 3 == 0);
+            let px: [[u8; 4]; 16] = std::array::from_fn(|_| {
+                let n = next();
+                let c = |k: u32| {
+                    (((base >> k) & 255) as i64 + ((n >> k) & 255) as i64 * spread / 255 - spread / 2).clamp(0, 255)
+                        as u8
+                };
+                [c(0), c(8), if blue_high { 255 - c(16) / 8 } else { c(16) }, 255]
+            });
+            let decoded = px.map(|p| p.map(|v| v & 0xfc));
+            for level in LEVELS {
+                let plain = search(&px, &decoded, i % 5 != 0, level, false);
+                assert_eq!(search(&px, &decoded, i % 5 != 0, level, true), plain, "block {i}, level {level}");
+            }
+        }
+    }
 }
