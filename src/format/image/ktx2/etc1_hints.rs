@@ -239,6 +239,7 @@ struct Subblock {
     max: [i32; 3],
     all_tables: bool,
     /// Whether to run the AVX2 build of [`Self::eval`].
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     wide: bool,
     /// The encoder stops trying tables at the first that is no better when the subblocks are
     /// columns (flip 0), and tries them all when they are rows.
