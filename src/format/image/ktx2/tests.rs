@@ -100,3 +100,50 @@ fn banded_uastc_transcoding_matches_one_call() {
     assert_eq!(banded.len(), (w * h * 4) as usize);
     assert!(banded == basis::tests_support::uastc_whole(&blocks, w, h));
 }
+
+/// Blocks of the kinds that reach every branch of the ETC1 hint search (`etc1_hints.rs`): noise, smooth and sharp
+/// normal-map blocks (blue near 255, where the tables clamp), near-black and near-white,
+/// greys, two-colour splits either way, and a few flat ones.
+pub(super) fn blocks() -> Vec<[u8; 64]> {
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let mut out = Vec::new();
+    for kind in 0..8 {
+        for _ in 0..60 {
+            let (a, b) = (next(), next());
+            let mut px = [255u8; 64];
+            for i in 0..16 {
+                let (x, y) = ((i % 4) as i32, (i / 4) as i32);
+                let r = (next() >> 32) as i32;
+                let c = |base: u64, k: u32| ((base >> k) & 255) as i32;
+                let rgb: [i32; 3] = match kind {
+                    0 => [r & 255, (r >> 8) & 255, (r >> 16) & 255],
+                    1 => [c(a, 0) / 2 + 64 + x * 3, c(a, 8) / 2 + 64 + y * 3, 250 - (r & 7)],
+                    2 => [128 + (r & 31) - 16, 128 + ((r >> 5) & 31) - 16, 255 - ((r >> 10) & 15)],
+                    3 => [c(a, 0) % 12 + x, c(a, 8) % 12 + y, (r & 7)],
+                    4 => [255 - (r & 15), 250 - x - y, 240 + ((r >> 4) & 15)],
+                    5 => {
+                        let g = c(a, 0) + (r & 7) - 3;
+                        [g, g, g]
+                    }
+                    6 => {
+                        let side = if a & 1 == 0 { x < 2 } else { y < 2 };
+                        let base = if side { a } else { b };
+                        [c(base, 0), c(base, 8), c(base, 16)]
+                    }
+                    _ => [c(a, 0), c(a, 8), c(a, 16)],
+                };
+                for k in 0..3 {
+                    px[4 * i + k] = rgb[k].clamp(0, 255) as u8;
+                }
+            }
+            out.push(px);
+        }
+    }
+    out
+}

@@ -9,6 +9,11 @@
 //! (tested against the compressor below) without those steps, and lets a block that repeats in
 //! its row (flat areas: a baked map's background, its UV padding) be encoded once.
 //!
+//! At pack levels 2-4 the block's ETC1 hints (what a transcoder to ETC1 follows instead of
+//! searching) are the encoder's search's answers found by `etc1_hints.rs` in a fraction of its
+//! time: the encoder is asked for its cheapest hints and these are written over them, at the bit
+//! offsets the block's mode gives.
+//!
 //! RDO passes over a whole level and ETC1S shares codebooks across levels, so both stay with
 //! the compressor (`write.rs`).
 
@@ -188,6 +193,7 @@ fn with_full_etc1_hints(b: &mut Block, px: &[u8; 64], level: u32) -> bool {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::blocks;
     use super::*;
 
     /// The encoder's own block, its hints from its full search.
@@ -200,53 +206,6 @@ mod tests {
 
     fn ours(px: &[u8; 64], level: u32) -> Block {
         block(px, level)
-    }
-
-    /// Blocks of the kinds that reach every branch of the search: noise, smooth and sharp
-    /// normal-map blocks (blue near 255, where the tables clamp), near-black and near-white,
-    /// greys, two-colour splits either way, and a few flat ones.
-    fn blocks() -> Vec<[u8; 64]> {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed
-        };
-        let mut out = Vec::new();
-        for kind in 0..8 {
-            for _ in 0..60 {
-                let (a, b) = (next(), next());
-                let mut px = [255u8; 64];
-                for i in 0..16 {
-                    let (x, y) = ((i % 4) as i32, (i / 4) as i32);
-                    let r = (next() >> 32) as i32;
-                    let c = |base: u64, k: u32| ((base >> k) & 255) as i32;
-                    let rgb: [i32; 3] = match kind {
-                        0 => [r & 255, (r >> 8) & 255, (r >> 16) & 255],
-                        1 => [c(a, 0) / 2 + 64 + x * 3, c(a, 8) / 2 + 64 + y * 3, 250 - (r & 7)],
-                        2 => [128 + (r & 31) - 16, 128 + ((r >> 5) & 31) - 16, 255 - ((r >> 10) & 15)],
-                        3 => [c(a, 0) % 12 + x, c(a, 8) % 12 + y, (r & 7)],
-                        4 => [255 - (r & 15), 250 - x - y, 240 + ((r >> 4) & 15)],
-                        5 => {
-                            let g = c(a, 0) + (r & 7) - 3;
-                            [g, g, g]
-                        }
-                        6 => {
-                            let side = if a & 1 == 0 { x < 2 } else { y < 2 };
-                            let base = if side { a } else { b };
-                            [c(base, 0), c(base, 8), c(base, 16)]
-                        }
-                        _ => [c(a, 0), c(a, 8), c(a, 16)],
-                    };
-                    for k in 0..3 {
-                        px[4 * i + k] = rgb[k].clamp(0, 255) as u8;
-                    }
-                }
-                out.push(px);
-            }
-        }
-        out
     }
 
     #[test]
