@@ -146,39 +146,52 @@ fn base_colors(c: [[i32; 3]; 2], individual: bool) -> [[i32; 3]; 2] {
     }
 }
 
+/// The bias modes that move one channel of one subblock by one step:
+/// (mode, subblock, channel, step).
+const ONE_CHANNEL_BIASES: [(u8, usize, usize, i32); 12] = [
+    (2, 0, 0, -1),
+    (5, 0, 1, -1),
+    (6, 0, 2, -1),
+    (7, 0, 0, 1),
+    (11, 0, 1, 1),
+    (15, 0, 2, 1),
+    (18, 1, 0, -1),
+    (19, 1, 1, -1),
+    (20, 1, 2, -1),
+    (21, 1, 0, 1),
+    (24, 1, 1, 1),
+    (8, 1, 2, 1),
+];
+
+/// The step bias mode `bias` gives channel `ch` of subblock `sub`: one channel of one subblock
+/// (above), every channel of one or both subblocks (10, 27-31), or, for the other modes, each
+/// channel its own base-3 digit of the mode, less one.
+fn bias_step(bias: u8, sub: usize, ch: usize) -> i32 {
+    if let Some(&(_, s, c, d)) = ONE_CHANNEL_BIASES.iter().find(|e| e.0 == bias) {
+        return if (s, c) == (sub, ch) { d } else { 0 };
+    }
+    // (subblock 0, subblock 1)
+    let both = match bias {
+        10 => (-2, -2),
+        27 => (-1, 0),
+        28 => (1, -1),
+        29 => (0, 1),
+        30 => (0, -1),
+        31 => (1, 0),
+        _ => return (bias as i32 / [1, 3, 9][ch]) % 3 - 1,
+    };
+    if sub == 0 {
+        both.0
+    } else {
+        both.1
+    }
+}
+
 /// A colour in ETC1 units moved by bias mode `bias` (the transcoder's rule: each channel by -2
 /// to +1, reflected where the move would leave 0..=`limit`), for subblock `sub`.
 fn apply_bias(c: [i32; 3], bias: u8, limit: i32, sub: usize) -> [i32; 3] {
-    let one = sub == 1;
     std::array::from_fn(|ch| {
-        let only = |on_sub1: bool, on_ch: usize, d: i32| if one == on_sub1 && ch == on_ch { d } else { 0 };
-        let delta = match bias {
-            2 => only(false, 0, -1),
-            5 => only(false, 1, -1),
-            6 => only(false, 2, -1),
-            7 => only(false, 0, 1),
-            11 => only(false, 1, 1),
-            15 => only(false, 2, 1),
-            18 => only(true, 0, -1),
-            19 => only(true, 1, -1),
-            20 => only(true, 2, -1),
-            21 => only(true, 0, 1),
-            24 => only(true, 1, 1),
-            8 => only(true, 2, 1),
-            10 => -2,
-            27 => -i32::from(!one),
-            28 => {
-                if one {
-                    -1
-                } else {
-                    1
-                }
-            }
-            29 => i32::from(one),
-            30 => -i32::from(one),
-            31 => i32::from(!one),
-            _ => (bias as i32 / [1, 3, 9][ch]) % 3 - 1,
-        };
+        let delta = bias_step(bias, sub, ch);
         let v = c[ch];
         if v == 0 {
             if delta == -2 {
