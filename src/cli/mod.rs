@@ -1,7 +1,7 @@
 //! Command-line types (clap derive), one file per subcommand, each with its `run`.
 
 #[macro_use]
-mod out;
+pub mod out;
 
 mod args;
 mod bake;
@@ -11,7 +11,8 @@ mod inspect;
 mod normalmap;
 mod preview;
 mod print;
-mod progress;
+pub mod process;
+pub mod progress;
 mod tangents;
 mod textures;
 mod validate;

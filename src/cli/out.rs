@@ -3,10 +3,24 @@
 //! with the code its work earned, so a pipeline's status stays truthful.
 
 use bumpbake::{Error, Result};
+use std::cell::RefCell;
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 static CLOSED: AtomicBool = AtomicBool::new(false);
+
+thread_local! {
+    /// Where this thread's output goes instead of stdout while [`captured`] runs.
+    static CAPTURE: RefCell<Option<Vec<u8>>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` with this thread's output collected instead of printed: how a front end that calls
+/// the command line in-process (the Python package's file-level calls) takes its JSON.
+pub fn captured<T>(f: impl FnOnce() -> T) -> (T, Vec<u8>) {
+    CAPTURE.with(|c| *c.borrow_mut() = Some(Vec::new()));
+    let r = f();
+    (r, CAPTURE.with(|c| c.borrow_mut().take()).unwrap_or_default())
+}
 
 /// Writes `s` to stdout; a closed pipe makes this and every later call a no-op.
 pub fn print(s: &str) -> Result<()> {
@@ -14,7 +28,8 @@ pub fn print(s: &str) -> Result<()> {
 }
 
 pub fn write_all(bytes: &[u8]) -> Result<()> {
-    if CLOSED.load(Ordering::Relaxed) {
+    let taken = CAPTURE.with(|c| c.borrow_mut().as_mut().map(|buf| buf.extend_from_slice(bytes)).is_some());
+    if taken || CLOSED.load(Ordering::Relaxed) {
         return Ok(());
     }
     let mut o = std::io::stdout().lock();

@@ -11,8 +11,27 @@ use std::time::Duration;
 /// A stage shorter than this draws nothing.
 const SHOW_AFTER: Duration = Duration::from_secs(1);
 
-/// True when a bar should be drawn: forced, or a terminal outside CI; never when quiet.
+thread_local! {
+    static FRONT_END: std::cell::RefCell<Option<Reporter>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Sends the progress of commands run on this thread to `r` instead of bars, until called with
+/// `None`: for a front end that runs the command line in-process and shows progress its own way
+/// (the Python package's `progress=` callable).
+pub fn report_to(r: Option<Reporter>) {
+    FRONT_END.with(|f| *f.borrow_mut() = r);
+}
+
+fn front_end() -> Option<Reporter> {
+    FRONT_END.with(|f| f.borrow().clone())
+}
+
+/// True when a bar should be drawn: forced, or a terminal outside CI; never when quiet. A front
+/// end's reporter wants every stage.
 pub fn wanted(force: bool, quiet: bool) -> bool {
+    if front_end().is_some() {
+        return true;
+    }
     if quiet {
         return false;
     }
@@ -23,7 +42,9 @@ pub fn wanted(force: bool, quiet: bool) -> bool {
 
 /// Bars for the library's progress when `wanted`, else a reporter that reports nothing.
 pub fn reporter(wanted: bool) -> Reporter {
-    if wanted {
+    if let Some(r) = front_end() {
+        r
+    } else if wanted {
         Reporter::new(Bars::default())
     } else {
         Reporter::none()

@@ -16,6 +16,7 @@ use crate::scene::weld::{CornerStream, CornerValues, SplitPlan};
 use crate::scene::{flat_normals, Geometry, Primitive, UvSource};
 use fallback::FallbackCounts;
 use glam::Vec3;
+use std::borrow::Cow;
 
 pub use crate::scene::view::gltf_w;
 
@@ -82,11 +83,32 @@ pub fn with_frames(g: Geometry, opts: &Options) -> (Primitive, FrameStats) {
     (out, stats)
 }
 
-/// Frames for every corner of `g`, repaired, and the vertices and streams they make: everything
-/// that reads the frames, which are freed on return.
-fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
+/// The engine's frames for every corner of a primitive, repaired, with the normals they were made
+/// against: what the writers store and [`corner_frames`] returns.
+struct Made<'a> {
+    frames: frames::Frames,
+    normals: Cow<'a, [[f32; 3]]>,
+    /// Per corner, the index of its normal in `normals`.
+    normal_of: Cow<'a, [u32]>,
+    generated_normals: bool,
+    fallback: FallbackCounts,
+}
+
+impl Made<'_> {
+    fn tangent(&self, c: usize) -> [f32; 4] {
+        self.frames.get(c, self.normal_of[c]).unwrap_or([0.0; 4])
+    }
+
+    /// `cross(N, T) * w`, the `_BITANGENT` every writer stores.
+    fn bitangent(&self, c: usize) -> [f32; 3] {
+        let t = self.tangent(c);
+        let n = Vec3::from(self.normals[self.normal_of[c] as usize]).normalize_or_zero();
+        (n.cross(Vec3::new(t[0], t[1], t[2])) * t[3]).to_array()
+    }
+}
+
+fn made<'a>(g: &'a Geometry, opts: &Options) -> Made<'a> {
     let p = &g.primitive;
-    let uv_name = g.tangent_uvs.attribute();
     let n_vertices = p.vertex_count();
     // Borrowed from the streams where possible. Without POSITION (callers skip such primitives)
     // the surface is a point.
@@ -95,46 +117,76 @@ fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
 
     // Without NORMAL, flat normals are made per corner (as the glTF spec asks of a client), and
     // MikkTSpace, which only sees values per corner, runs on the unwelded triangles.
-    let normals = g.normals();
-    let generated_normals = normals.is_none();
-    // Declared before the branch so the engine's input can borrow them in one arm only.
-    #[allow(clippy::type_complexity)]
-    let (corner_ids, cp, cu, flat): (Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<[f32; 3]>);
-    let (normals, normal_of, mut frames) = match normals {
+    let (normals, normal_of, mut frames, generated_normals): (Cow<[[f32; 3]]>, Cow<[u32]>, _, _) = match g.normals() {
         None => {
-            cp = p.indices.iter().map(|&i| positions[i as usize]).collect();
-            flat = flat_normals(&cp).0;
-            cu = p.indices.iter().map(|&i| uvs[i as usize]).collect();
-            corner_ids = (0..p.indices.len() as u32).collect();
+            let cp: Vec<[f32; 3]> = p.indices.iter().map(|&i| positions[i as usize]).collect();
+            let flat = flat_normals(&cp).0;
+            let cu: Vec<[f32; 2]> = p.indices.iter().map(|&i| uvs[i as usize]).collect();
+            let corner_ids: Vec<u32> = (0..p.indices.len() as u32).collect();
             let frames = generate_with_stack(
                 &TriMesh { positions: &cp, normals: &flat, uvs: &cu, indices: &corner_ids },
                 opts.engine,
             );
-            (flat.as_slice().into(), corner_ids.as_slice(), frames)
+            (flat.into(), corner_ids.into(), frames, true)
         }
         Some(n) => {
             let frames = generate_with_stack(
                 &TriMesh { positions: &positions, normals: &n, uvs: &uvs, indices: &p.indices },
                 opts.engine,
             );
-            (n, p.indices.as_slice(), frames)
+            (n, p.indices.as_slice().into(), frames, false)
         }
     };
     drop((positions, uvs));
     crate::timings::mem_mark("engine");
     to_gltf_w(&mut frames);
-    let fallback =
-        fallback::repair(&mut frames, fallback::CornerNormals { normals: &normals, normal_of, vertex: &p.indices });
+    let fallback = fallback::repair(
+        &mut frames,
+        fallback::CornerNormals { normals: &normals, normal_of: &normal_of, vertex: &p.indices },
+    );
     crate::timings::mem_mark("repair");
+    Made { frames, normals, normal_of, generated_normals, fallback }
+}
 
+/// Every corner's frame, as the writers store it (glTF's `w`, fallback frames where MikkTSpace
+/// gives none), and its bitangent when [`Options::bitangents`] asks: for callers that keep
+/// their own vertices (a DCC's corners), where [`with_frames`] splits and welds a primitive.
+#[derive(Debug, Clone)]
+pub struct CornerFrames {
+    /// `(t.x, t.y, t.z, w)` per corner of the index list.
+    pub tangents: Vec<[f32; 4]>,
+    /// `cross(N, T) * w` per corner.
+    pub bitangents: Option<Vec<[f32; 3]>>,
+    pub fallback: FallbackCounts,
+    /// NORMAL was missing and flat normals were made.
+    pub generated_normals: bool,
+}
+
+/// [`CornerFrames`] of `g`, a triangle list.
+pub fn corner_frames(g: &Geometry, opts: &Options) -> CornerFrames {
+    let m = made(g, opts);
+    let corners = g.primitive.indices.len();
+    CornerFrames {
+        tangents: (0..corners).map(|c| m.tangent(c)).collect(),
+        bitangents: opts.bitangents.then(|| (0..corners).map(|c| m.bitangent(c)).collect()),
+        fallback: m.fallback,
+        generated_normals: m.generated_normals,
+    }
+}
+
+/// Frames for every corner of `g`, repaired, and the vertices and streams they make: everything
+/// that reads the frames, which are freed on return.
+fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
+    let p = &g.primitive;
+    let uv_name = g.tangent_uvs.attribute();
+    let m = made(g, opts);
+    let (normals, generated_normals) = (&m.normals, m.generated_normals);
     // Every corner has a frame now. Tangents and bitangents are read through the compact frames,
     // never spelt out per corner.
-    let tangent = |c: usize| frames.get(c, normal_of[c]).unwrap_or([0.0; 4]);
+    let tangent = |c: usize| m.tangent(c);
     let bitangent = |c: usize| {
-        let t = tangent(c);
-        let b =
-            Vec3::from(normals[normal_of[c] as usize]).normalize_or_zero().cross(Vec3::new(t[0], t[1], t[2])) * t[3];
-        [b.x, b.y, b.z, 0.0]
+        let b = m.bitangent(c);
+        [b[0], b[1], b[2], 0.0]
     };
     let mut extra = Vec::new();
     if generated_normals {
@@ -175,7 +227,7 @@ fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
             )
         })
         .collect();
-    (SplitPlan::with_targets(p, &["TANGENT", "_BITANGENT"], &extra, &target_extra), fallback)
+    (SplitPlan::with_targets(p, &["TANGENT", "_BITANGENT"], &extra, &target_extra), m.fallback)
 }
 
 /// Stack bytes the reference needs per triangle around one vertex, with a wide margin.
