@@ -19,7 +19,8 @@ from __future__ import annotations
 import difflib
 import json
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from collections.abc import Sequence
+from typing import Any, Callable, Union
 
 import numpy as np
 
@@ -87,7 +88,7 @@ def _indices(a: Any, vertices: int) -> np.ndarray:
     return np.require(arr, dtype=np.uint32, requirements=["C", "A"])
 
 
-def _addr(a: Optional[np.ndarray]) -> int:
+def _addr(a: np.ndarray | None) -> int:
     return 0 if a is None else int(a.__array_interface__["data"][0])
 
 
@@ -100,7 +101,7 @@ def tangents(
     bitangents: bool = False,
     uv_origin: str = "top-left",
     corners: bool = False,
-) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """MikkTSpace tangents of a triangle list, bit for bit what ``bumpbake tangents`` writes.
 
     Args:
@@ -164,7 +165,7 @@ def tangents(
     return (out_t, out_b) if out_b is not None else out_t
 
 
-def _height(a: Any) -> Tuple[np.ndarray, str]:
+def _height(a: Any) -> tuple[np.ndarray, str]:
     arr = np.asarray(a)
     if arr.ndim == 3 and arr.shape[2] == 1:
         arr = arr[:, :, 0]
@@ -183,7 +184,7 @@ def _height(a: Any) -> Tuple[np.ndarray, str]:
     return np.require(arr, requirements=["C", "A"]), kind
 
 
-def _strength(strength: Optional[float], height_range: Optional[float], texel_size: Optional[float]) -> float:
+def _strength(strength: float | None, height_range: float | None, texel_size: float | None) -> float:
     if strength is not None and (height_range is not None or texel_size is not None):
         raise UsageError("strength cannot be given with height_range and texel_size: give one or the other")
     if (height_range is None) != (texel_size is None):
@@ -204,9 +205,9 @@ def _strength(strength: Optional[float], height_range: Optional[float], texel_si
 def normalmap(
     height: Any,
     *,
-    strength: Optional[float] = None,
-    height_range: Optional[float] = None,
-    texel_size: Optional[float] = None,
+    strength: float | None = None,
+    height_range: float | None = None,
+    texel_size: float | None = None,
     convention: str = "opengl",
     filter: str = "sobel",
     wrap: str = "clamp",
@@ -214,8 +215,8 @@ def normalmap(
     bits: int = 8,
     alpha: bool = False,
     report: bool = False,
-    progress: Optional[Progress] = None,
-) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, Any]]]:
+    progress: Progress | None = None,
+) -> np.ndarray | tuple[np.ndarray, dict[str, Any]]:
     """A tangent-space normal map of a height field, texel for texel what ``bumpbake normalmap``
     writes.
 
@@ -250,7 +251,18 @@ def normalmap(
     out = np.empty((rows, cols, 4 if alpha else 3), dtype=dtype)
     info = json.loads(
         _native.normalmap(
-            _addr(arr), kind, cols, rows, s, filter, wrap, bool(invert), convention, bits, bool(alpha), _addr(out),
+            _addr(arr),
+            kind,
+            cols,
+            rows,
+            s,
+            filter,
+            wrap,
+            bool(invert),
+            convention,
+            bits,
+            bool(alpha),
+            _addr(out),
             progress,
         )
     )
@@ -259,13 +271,28 @@ def normalmap(
 
 # File-level calls: the command line's parser, checks and JSON, keywords passed as its flags.
 
-_TABLES: Dict[str, Dict[str, Tuple[Optional[str], bool, bool]]] = {}
+_TABLES: dict[str, dict[str, tuple[str | None, bool, bool]]] = {}
 # Keywords the calls below set themselves (the JSON output, one input, one output).
-_OWN = {"inputs", "files", "input", "heights", "output", "out_dir", "out_ext", "json", "format", "quiet", "jobs",
-        "progress", "from", "depfile", "list_codes"}
+_OWN = {
+    "inputs",
+    "files",
+    "input",
+    "heights",
+    "output",
+    "out_dir",
+    "out_ext",
+    "json",
+    "format",
+    "quiet",
+    "jobs",
+    "progress",
+    "from",
+    "depfile",
+    "list_codes",
+}
 
 
-def _table(command: str) -> Dict[str, Tuple[Optional[str], bool, bool]]:
+def _table(command: str) -> dict[str, tuple[str | None, bool, bool]]:
     if command not in _TABLES:
         _TABLES[command] = {kw: (flag, takes, many) for kw, flag, takes, many in _native.options(command)}
     return _TABLES[command]
@@ -281,9 +308,9 @@ def _text(keyword: str, v: Any) -> str:
     return str(v)
 
 
-def _argv(function: str, command: str, options: Dict[str, Any]) -> List[str]:
+def _argv(function: str, command: str, options: dict[str, Any]) -> list[str]:
     table = _table(command)
-    argv: List[str] = []
+    argv: list[str] = []
     for kw, value in options.items():
         entry = table.get(kw)
         if kw in _OWN or entry is None or entry[0] is None:
@@ -305,20 +332,26 @@ def _argv(function: str, command: str, options: Dict[str, Any]) -> List[str]:
     return argv
 
 
-def _run(function: str, command: str, own: List[str], paths: List[PathLike], options: Dict[str, Any],
-         progress: Optional[Progress]) -> Dict[str, Any]:
+def _run(
+    function: str,
+    command: str,
+    own: list[str],
+    paths: list[PathLike],
+    options: dict[str, Any],
+    progress: Progress | None,
+) -> dict[str, Any]:
     argv = ["bumpbake", command, *own, *_argv(function, command, options), "--", *(os.fspath(p) for p in paths)]
     _code, out = _native.run(argv, progress)
     return json.loads(out)
 
 
-def inspect(path: PathLike, **options: Any) -> Dict[str, Any]:
+def inspect(path: PathLike, **options: Any) -> dict[str, Any]:
     """What a mesh file holds, as ``bumpbake inspect --json`` prints it: primitives, attributes,
     materials, tangents, images. Options: ``allow_outside``."""
     return _run("inspect", "inspect", ["--json"], [path], options, None)
 
 
-def validate(path: PathLike, **options: Any) -> Dict[str, Any]:
+def validate(path: PathLike, **options: Any) -> dict[str, Any]:
     """Tangent-frame, handedness and normal-map checks of a glTF/GLB/OBJ, as
     ``bumpbake validate --format json`` prints them. Findings are in the dict (``errors`` and
     ``warnings`` counts, each finding with its code); they do not raise. Options: ``strict``,
@@ -327,24 +360,30 @@ def validate(path: PathLike, **options: Any) -> Dict[str, Any]:
     return _run("validate", "validate", ["--format=json"], [path], options, None)
 
 
-def tangents_file(input: PathLike, output: PathLike, *, progress: Optional[Progress] = None,
-                  **options: Any) -> Dict[str, Any]:
+def tangents_file(
+    input: PathLike, output: PathLike, *, progress: Progress | None = None, **options: Any
+) -> dict[str, Any]:
     """``bumpbake tangents INPUT -o OUTPUT``: MikkTSpace tangents where the scene needs them,
     written to a .glb or .gltf. Returns the JSON record. Options as the command's flags:
     ``bitangents``, ``all``, ``overwrite``, ``embed``, ``images``, ``allow_outside``, ..."""
-    return _run("tangents_file", "tangents", ["--json", f"--output={os.fspath(output)}"], [input], options,
-                progress)
+    return _run("tangents_file", "tangents", ["--json", f"--output={os.fspath(output)}"], [input], options, progress)
 
 
-def bake(input: PathLike, output: PathLike, *, progress: Optional[Progress] = None, **options: Any) -> Dict[str, Any]:
+def bake(input: PathLike, output: PathLike, *, progress: Progress | None = None, **options: Any) -> dict[str, Any]:
     """``bumpbake bake INPUT -o OUTPUT``: mesh + height or normal map -> a render-ready glTF.
     Options as the command's flags: ``height``, ``normal``, ``strength``, ``height_range``,
     ``texel_size``, ``material``, ``convention``, ``textures``, ... Returns the JSON record."""
     return _run("bake", "bake", ["--json", f"--output={os.fspath(output)}"], [input], options, progress)
 
 
-def bake_from(low: PathLike, high: Union[PathLike, Sequence[PathLike]], output: PathLike, *,
-              progress: Optional[Progress] = None, **options: Any) -> Dict[str, Any]:
+def bake_from(
+    low: PathLike,
+    high: PathLike | Sequence[PathLike],
+    output: PathLike,
+    *,
+    progress: Progress | None = None,
+    **options: Any,
+) -> dict[str, Any]:
     """``bumpbake bake LOW --from HIGH -o OUTPUT``: HIGH's detail baked onto LOW's UV layout.
     ``high`` is one path or several. Options as the command's flags: ``size``, ``samples``,
     ``padding``, ``ray_front``, ``ray_back``, ``cage``, ``map_out``, ``height_out``, ``node``, ...
@@ -356,8 +395,7 @@ def bake_from(low: PathLike, high: Union[PathLike, Sequence[PathLike]], output: 
     return _run("bake_from", "bake", own, [low], options, progress)
 
 
-def textures(input: PathLike, output: PathLike, *, progress: Optional[Progress] = None,
-             **options: Any) -> Dict[str, Any]:
+def textures(input: PathLike, output: PathLike, *, progress: Progress | None = None, **options: Any) -> dict[str, Any]:
     """``bumpbake textures INPUT -o OUTPUT``: normal maps re-encoded as KTX2 with mips made from
     the normals, roughness widened to match (specular antialiasing). Options as the command's
     flags: ``ktx2``, ``ktx2_quality``, ``no_specular_aa``, ``images``, ... Returns the JSON record."""

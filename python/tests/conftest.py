@@ -73,9 +73,11 @@ class Gltf:
         start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
         stride = view.get("byteStride", dtype.itemsize * width)
         buf = self.buffers[view["buffer"]]
-        rows = [np.frombuffer(buf, dtype, width, start + i * stride) for i in range(a["count"])] if stride != (
-            dtype.itemsize * width
-        ) else [np.frombuffer(buf, dtype, width * a["count"], start).reshape(-1, width)]
+        rows = (
+            [np.frombuffer(buf, dtype, width, start + i * stride) for i in range(a["count"])]
+            if stride != (dtype.itemsize * width)
+            else [np.frombuffer(buf, dtype, width * a["count"], start).reshape(-1, width)]
+        )
         return np.vstack(rows) if width > 1 else np.concatenate(rows).reshape(-1)
 
     def primitives(self):

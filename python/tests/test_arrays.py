@@ -29,10 +29,14 @@ def written_frames(path):
 def assert_same_bits(got, want):
     assert got.shape == want.shape and got.dtype == want.dtype
     differ = got.view(np.uint32) != want.view(np.uint32)
-    assert not differ.any(), f"{differ.any(axis=1).sum()} of {len(got)} rows differ; first {np.argmax(differ.any(axis=1))}"
+    assert not differ.any(), (
+        f"{differ.any(axis=1).sum()} of {len(got)} rows differ; first {np.argmax(differ.any(axis=1))}"
+    )
 
 
-@pytest.mark.parametrize("fixture, extra", [("bake/torus.obj", []), ("khronos/NormalTangentMirrorTest.glb", ["--overwrite"])])
+@pytest.mark.parametrize(
+    "fixture, extra", [("bake/torus.obj", []), ("khronos/NormalTangentMirrorTest.glb", ["--overwrite"])]
+)
 def test_tangents_reproduce_the_command_lines_accessor(tmp_path, fixtures, fixture, extra):
     out = tmp_path / "out.gltf"
     run_cli("tangents", fixtures / fixture, "-o", out, "--all", "--bitangents", *extra)
@@ -57,7 +61,9 @@ def test_float64_inputs_and_bottom_left_uvs(tmp_path, fixtures):
     up[:, 1] = np.float32(1) - up[:, 1]
     down = up.copy()
     down[:, 1] = np.float32(1) - down[:, 1]
-    assert_same_bits(bumpbake.tangents(pos, nor, up, idx, uv_origin="bottom-left"), bumpbake.tangents(pos, nor, down, idx))
+    assert_same_bits(
+        bumpbake.tangents(pos, nor, up, idx, uv_origin="bottom-left"), bumpbake.tangents(pos, nor, down, idx)
+    )
     assert not np.array_equal(bumpbake.tangents(pos, nor, up, idx), tan)
 
 
@@ -97,8 +103,14 @@ def write_gltf(path, pos, nor, uv, idx):
         at += len(b)
     (path.parent / "grid.bin").write_bytes(b"".join(blobs))
     acc = [
-        {"bufferView": 0, "componentType": 5126, "count": len(pos), "type": "VEC3",
-         "min": pos.min(0).tolist(), "max": pos.max(0).tolist()},
+        {
+            "bufferView": 0,
+            "componentType": 5126,
+            "count": len(pos),
+            "type": "VEC3",
+            "min": pos.min(0).tolist(),
+            "max": pos.max(0).tolist(),
+        },
         {"bufferView": 1, "componentType": 5126, "count": len(nor), "type": "VEC3"},
         {"bufferView": 2, "componentType": 5126, "count": len(uv), "type": "VEC2"},
         {"bufferView": 3, "componentType": 5125, "count": len(idx), "type": "SCALAR"},
@@ -133,11 +145,14 @@ def heights(rows: int, cols: int) -> np.ndarray:
 
 
 @pytest.mark.parametrize("bits, dtype", [(8, np.uint8), (16, np.uint16)])
-@pytest.mark.parametrize("options", [
-    {"strength": 6.0},
-    {"height_range": 0.02, "texel_size": 0.001, "convention": "directx", "filter": "scharr", "wrap": "repeat"},
-    {"strength": 3.0, "invert": True, "filter": "spectral", "alpha": True},
-])
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"strength": 6.0},
+        {"height_range": 0.02, "texel_size": 0.001, "convention": "directx", "filter": "scharr", "wrap": "repeat"},
+        {"strength": 3.0, "invert": True, "filter": "spectral", "alpha": True},
+    ],
+)
 def test_normalmap_equals_the_command_lines_png(tmp_path, bits, dtype, options):
     h = np.round(heights(48, 64) * np.iinfo(dtype).max).astype(dtype)
     src = tmp_path / "h.png"

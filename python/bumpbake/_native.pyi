@@ -1,0 +1,37 @@
+"""The extension module. Private: call the checked functions of ``bumpbake`` instead; these take
+raw array addresses that the package makes safe."""
+
+from typing import Any, Callable, Optional
+
+__version__: str
+
+def tangents(
+    vertices: int,
+    positions: int,
+    normals: int,
+    uvs: int,
+    indices: int,
+    corners: int,
+    flip_v: bool,
+    per_vertex: bool,
+    out_tangents: int,
+    out_bitangents: int,
+) -> str: ...
+def normalmap(
+    height: int,
+    dtype: str,
+    width: int,
+    rows: int,
+    strength: float,
+    filter: str,
+    wrap: str,
+    invert: bool,
+    convention: str,
+    bits: int,
+    alpha: bool,
+    out: int,
+    progress: Optional[Callable[[str, int, int, str], Any]] = None,
+) -> str: ...
+def run(argv: list[str], progress: Optional[Callable[[str, int, int, str], Any]] = None) -> tuple[int, str]: ...
+def main(argv: list[str]) -> int: ...
+def options(command: str) -> list[tuple[str, Optional[str], bool, bool]]: ...
