@@ -1,7 +1,7 @@
 """The extension module. Private: call the checked functions of ``bumpbake`` instead; these take
 raw array addresses that the package makes safe."""
 
-from typing import Any, Callable, Optional
+from typing import Any, Callable
 
 __version__: str
 
@@ -30,8 +30,8 @@ def normalmap(
     bits: int,
     alpha: bool,
     out: int,
-    progress: Optional[Callable[[str, int, int, str], Any]] = None,
+    progress: Callable[[str, int, int, str], Any] | None = None,
 ) -> str: ...
-def run(argv: list[str], progress: Optional[Callable[[str, int, int, str], Any]] = None) -> tuple[int, str]: ...
+def run(argv: list[str], progress: Callable[[str, int, int, str], Any] | None = None) -> tuple[int, str]: ...
 def main(argv: list[str]) -> int: ...
-def options(command: str) -> list[tuple[str, Optional[str], bool, bool]]: ...
+def options(command: str) -> list[tuple[str, str | None, bool, bool]]: ...
