@@ -207,7 +207,7 @@ fn split_plan(g: &Geometry, opts: &Options) -> (SplitPlan, FallbackCounts) {
         });
     }
     let morph = if morph::needed(p, &uv_name) {
-        let base = morph::Base { tangent: &tangent, normals: &normals, generated_normals };
+        let base = morph::Base { tangent: &tangent, normals, generated_normals };
         morph::deltas(g, &base, opts.engine)
     } else {
         Vec::new()
