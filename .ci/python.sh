@@ -10,7 +10,20 @@ work="$target/python-ci"
 rm -rf "$work" && mkdir -p "$work"
 pins="$PWD/python/requirements-ci.txt"
 
-python3.11 -m venv "$work/build"
+# CPython X.Y: on PATH when it runs, else pyenv's newest X.Y.* (its shims answer only for the
+# versions pyenv is set to).
+python_of() {
+  if "python$1" -c '' 2>/dev/null; then
+    command -v "python$1"
+    return
+  fi
+  local found
+  found=$(ls -d "$(pyenv root 2>/dev/null)/versions/$1".* 2>/dev/null | sort -V | tail -n 1)
+  [ -n "$found" ] || { echo "CPython $1 is not installed" >&2; return 1; }
+  echo "$found/bin/python$1"
+}
+
+"$(python_of 3.11)" -m venv "$work/build"
 "$work/build/bin/pip" install --quiet --disable-pip-version-check -r "$pins"
 "$work/build/bin/ruff" check python
 "$work/build/bin/ruff" format --check python
@@ -24,11 +37,11 @@ plain="$work/plain-bin"
 mkdir -p "$plain"
 for tool in sh env uname; do ln -sf "$(command -v "$tool")" "$plain/$tool"; done
 
-for py in python3.11 python3.12; do
-  venv="$work/venv-$py"
-  "$py" -m venv "$venv"
+for version in 3.11 3.12; do
+  venv="$work/venv-$version"
+  "$(python_of "$version")" -m venv "$venv"
   "$venv/bin/pip" install --quiet --disable-pip-version-check "$wheel" "$(grep '^numpy' "$pins")" "$(grep '^pytest' "$pins")"
-  echo "== $py: the wheel with no toolchain on PATH"
+  echo "== CPython $version: the wheel with no toolchain on PATH"
   env -i HOME="$HOME" PATH="$venv/bin:$plain" sh -c '
     for t in cargo rustc cc c++ gcc g++; do
       if command -v "$t" >/dev/null; then echo "toolchain on PATH: $t" >&2; exit 1; fi
