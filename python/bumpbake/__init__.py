@@ -232,7 +232,7 @@ def normalmap(
         invert: the input is a depth map (white is deep).
         bits: 8 (uint8 texels), 16 (uint16) or 32 (float32 unit vectors, not encoded).
         alpha: a fourth channel holding the height (after ``invert``), for parallax mapping.
-        report: also return a dict: the options, the steepest slope and the warnings (a map
+        report: also return a dict: the options, the steepest slope, ``engine_ms`` and the warnings (a map
             that came out nearly flat, with the strength that would show it).
         progress: ``progress(stage, done, total, unit)``, called as rows finish.
 
@@ -263,6 +263,7 @@ def normalmap(
             bits,
             bool(alpha),
             _addr(out),
+            bool(report),
             progress,
         )
     )

@@ -30,6 +30,7 @@ def normalmap(
     bits: int,
     alpha: bool,
     out: int,
+    report: bool,
     progress: Callable[[str, int, int, str], Any] | None = None,
 ) -> str: ...
 def run(argv: list[str], progress: Callable[[str, int, int, str], Any] | None = None) -> tuple[int, str]: ...

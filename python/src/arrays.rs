@@ -175,10 +175,10 @@ fn height_plane(addr: usize, dtype: &str, width: usize, rows: usize) -> Option<H
 
 /// A tangent-space normal map of a height array, encoded as the command line writes it, into
 /// `out` (`rows` x `width` x channels of uint8, uint16 or float32 for `bits` 8, 16, 32).
-/// Returns the report (the flatness warning, the steepest slope) as JSON.
+/// Returns the report (the flatness warning; with `report`, the steepest slope) as JSON.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (height, dtype, width, rows, strength, filter, wrap, invert, convention, bits, alpha, out, progress=None))]
+#[pyo3(signature = (height, dtype, width, rows, strength, filter, wrap, invert, convention, bits, alpha, out, report, progress=None))]
 pub fn normalmap(
     py: Python<'_>,
     height: usize,
@@ -193,6 +193,7 @@ pub fn normalmap(
     bits: u32,
     alpha: bool,
     out: usize,
+    report: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let usage = |what: &str, v: &str| raise(py, Kind::Usage, format!("{what}={v:?} is not one of bumpbake's"));
@@ -257,8 +258,10 @@ pub fn normalmap(
         };
         reporter.finish();
         // Judged on the texels as an image would store them, as the command line judges them.
+        // The flatness check is the command's too: part of the library's work.
+        let warning = nm::Flatness::of_image(&img).warning(&plane, strength, 1.0);
         let engine_ms = start.elapsed().as_secs_f64() * 1e3;
-        (nm::Flatness::of_image(&img).warning(&plane, strength, 1.0), nm::steepest_slope(&plane), engine_ms)
+        (warning, report.then(|| nm::steepest_slope(&plane)), engine_ms)
     });
     if let Some(e) = callback.and_then(|c| c.take_error()) {
         return Err(e);

@@ -1,6 +1,6 @@
 """The binding's cost: a 2048^2 normal map and a 1M-triangle tangent call from Python, against the
 same work in the library (the time the engine reports for itself inside the same call), in the
-same run. Medians of RUNS calls. `python python/bench.py [RUNS]`; figures in docs/python.md."""
+same run. Medians of RUNS calls. `python python/benches/binding.py [RUNS]`; figures in docs/python.md."""
 
 from __future__ import annotations
 
