@@ -15,6 +15,7 @@ mod progress;
 mod tangents;
 mod textures;
 mod validate;
+pub mod wording;
 
 use bumpbake::Result;
 use clap::{Parser, Subcommand};

@@ -57,7 +57,7 @@ impl Progress for Bars {
         };
         let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
         b.set_style(ProgressStyle::with_template(template).expect("valid template").progress_chars("=> "));
-        b.set_prefix(stage.to_string());
+        b.set_prefix(super::wording::stage(stage).to_string());
         if unit != "files" {
             b.set_message(unit.to_string());
         }
