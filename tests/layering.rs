@@ -353,7 +353,7 @@ fn string_literals(text: &str) -> Vec<String> {
                 i += 1;
                 continue;
             }
-            let close: String = std::iter::once('"').chain(std::iter::repeat('#').take(hashes)).collect();
+            let close: String = std::iter::once('"').chain(std::iter::repeat_n('#', hashes)).collect();
             let body: String = c[i + 2 + hashes..].iter().collect();
             let end = body.find(&close).expect("a raw string ends");
             lits.push(body[..end].to_string());
