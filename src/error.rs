@@ -61,7 +61,8 @@ pub enum Setting {
 }
 
 impl Setting {
-    /// Every setting, in declaration order.
+    /// Every setting, in declaration order (a new variant goes here too: the front ends' tests
+    /// check each has a name).
     pub const EVERY: [Setting; 20] = [
         Setting::Convention,
         Setting::Material,
