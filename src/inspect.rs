@@ -154,7 +154,7 @@ pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
         // Listing reads the JSON; whether the data can be read is the reading rule's answer,
         // the same every other command gets.
         let error = scene.primitive(r).err().map(|e| match e {
-            crate::Error::Input { msg, .. } => msg,
+            crate::Error::Input { msg, .. } => msg.to_string(),
             other => other.to_string(),
         });
         let (elements, element) = elements(mode, d.index_count.unwrap_or(d.vertices));

@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let args = cli::Cli::parse();
+    bumpbake::error::install(&cli::wording::Flags);
     cli::process::tune_the_allocator(args.bakes_from_high());
     cli::process::clean_up_on_signals();
     match cli::run(args) {

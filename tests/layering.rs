@@ -317,3 +317,126 @@ fn the_rules_see_their_targets() {
     assert!(g["cli/bench/tangents/plot.rs"].contains("cli/bench/tangents.rs"), "{:?}", g["cli/bench/tangents/plot.rs"]);
     assert!(g["bake/maps.rs"].contains("validate/mod.rs"), "{:?}", g["bake/maps.rs"]);
 }
+
+/// The string literals of Rust source, outside comments and outside the items under
+/// `#[cfg(test)]` (a test may spell a flag to check the command line).
+fn string_literals(text: &str) -> Vec<String> {
+    let c: Vec<char> = text.chars().collect();
+    let ident = |i: usize| i < c.len() && (c[i].is_alphanumeric() || c[i] == '_');
+    // The code with each literal replaced by \u{1}, and the literals in order.
+    let (mut code, mut lits) = (String::new(), Vec::new());
+    let mut i = 0;
+    while i < c.len() {
+        let raw_start = c[i] == 'r' && (i == 0 || !ident(i - 1) || (c[i - 1] == 'b' && (i < 2 || !ident(i - 2))));
+        if c[i] == '/' && c.get(i + 1) == Some(&'/') {
+            while i < c.len() && c[i] != '\n' {
+                i += 1;
+            }
+        } else if c[i] == '/' && c.get(i + 1) == Some(&'*') {
+            let mut depth = 0;
+            while i < c.len() {
+                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
+                    (depth, i) = (depth + 1, i + 2);
+                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
+                    (depth, i) = (depth - 1, i + 2);
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+        } else if raw_start && matches!(c.get(i + 1), Some('#') | Some('"')) {
+            let hashes = c[i + 1..].iter().take_while(|&&h| h == '#').count();
+            if c.get(i + 1 + hashes) != Some(&'"') {
+                code.push(c[i]);
+                i += 1;
+                continue;
+            }
+            let close: String = std::iter::once('"').chain(std::iter::repeat_n('#', hashes)).collect();
+            let body: String = c[i + 2 + hashes..].iter().collect();
+            let end = body.find(&close).expect("a raw string ends");
+            lits.push(body[..end].to_string());
+            code.push('\u{1}');
+            i += 2 + hashes + body[..end].chars().count() + close.len();
+        } else if c[i] == '"' {
+            let mut s = String::new();
+            i += 1;
+            while i < c.len() && c[i] != '"' {
+                if c[i] == '\\' {
+                    s.push(c[i]);
+                    i += 1;
+                }
+                s.push(c[i]);
+                i += 1;
+            }
+            lits.push(s);
+            code.push('\u{1}');
+            i += 1;
+        } else if c[i] == '\'' && c.get(i + 1) == Some(&'\\') {
+            i += 2;
+            while i < c.len() && c[i] != '\'' {
+                i += 1;
+            }
+            i += 1;
+        } else if c[i] == '\'' && c.get(i + 2) == Some(&'\'') {
+            i += 3;
+        } else {
+            code.push(c[i]);
+            i += 1;
+        }
+    }
+    // Drop the literals of each item under `#[cfg(test)]`: up to its `;`, or its braces' end.
+    let mut tested = vec![false; lits.len()];
+    let marks = |s: &str| s.matches('\u{1}').count();
+    for (at, _) in code.match_indices("#[cfg(test)]") {
+        let rest = &code[at..];
+        let Some(open) = rest.find(['{', ';']) else { continue };
+        let mut end = open + 1;
+        if rest[open..].starts_with('{') {
+            let mut depth = 0;
+            for (k, ch) in rest[open..].char_indices() {
+                depth += (ch == '{') as i32 - (ch == '}') as i32;
+                if depth == 0 {
+                    end = open + k + 1;
+                    break;
+                }
+            }
+        }
+        let first = marks(&code[..at]);
+        for t in &mut tested[first..first + marks(&rest[..end])] {
+            *t = true;
+        }
+    }
+    lits.into_iter().zip(tested).filter(|(_, t)| !t).map(|(l, _)| l).collect()
+}
+
+/// Whether a literal names a command-line flag: `--` and a letter.
+fn names_a_flag(lit: &str) -> bool {
+    let b = lit.as_bytes();
+    (0..b.len().saturating_sub(2))
+        .any(|i| &b[i..i + 2] == b"--" && b[i + 2].is_ascii_alphabetic() && (i == 0 || b[i - 1] != b'-'))
+}
+
+/// The library speaks of its settings as data (`error::Setting`); each front end names them (the
+/// command line with its flags), so no string of the library names a flag.
+#[test]
+fn no_string_of_the_library_names_a_flag() {
+    // Fix advice to a person, naming `bumpbake` commands (its header says so).
+    const ADVICE: &str = "validate/codes.rs";
+    let sample = "let a = \"pass --convention\"; // \"--no\"\n/* \"--no\" */ let c = '\"'; let r = r#\"x --raw\"#;\n\
+                  #[cfg(test)]\nmod tests { fn t() { let b = \"--no\"; } }\nfn f() { \"--yes\" }";
+    let seen: Vec<String> = string_literals(sample).into_iter().filter(|l| names_a_flag(l)).collect();
+    assert_eq!(seen, ["pass --convention", "x --raw", "--yes"]);
+    assert!(!names_a_flag("a -- b") && !names_a_flag("----") && names_a_flag("--max-pixels"));
+
+    let offenders: Vec<(String, String)> = files()
+        .into_iter()
+        .filter(|f| !in_binary(f) && f != ADVICE && !f.ends_with("/tests.rs"))
+        .flat_map(|f| {
+            let text = std::fs::read_to_string(src().join(&f)).unwrap();
+            string_literals(&text).into_iter().filter(|l| names_a_flag(l)).map(move |l| (f.clone(), l))
+        })
+        .collect();
+    assert!(offenders.is_empty(), "flags named in the library's strings: {offenders:#?}");
+}

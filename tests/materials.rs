@@ -362,6 +362,8 @@ fn only_the_scene_model_reads_material_json() {
         let other = ["/textures/", "material_of("].iter().any(|l| line.contains(l));
         other || json_keys(line).into_iter().any(is_material_key)
     });
+    // `error.rs` names the settings a message refers to ("material" is one), not JSON keys.
+    let bad: Vec<String> = bad.into_iter().filter(|l| !l.contains("src/error.rs:")).collect();
     assert!(bad.is_empty(), "material JSON read outside src/scene/ (ask Scene::materials):\n{}", bad.join("\n"));
 }
 

@@ -136,7 +136,7 @@ fn bake_from_reports_both_reads_and_every_row() {
     r.unwrap();
     let bytes = std::fs::metadata(&low).unwrap().len();
     let read_stage = ("read torus.obj".to_string(), bytes, "bytes".to_string(), bytes);
-    let rows = ("bake --from".to_string(), 40, "rows".to_string(), 40);
+    let rows = (bumpbake::transfer::STAGE.to_string(), 40, "rows".to_string(), 40);
     // LOW, then HIGH, then the rays.
     assert_eq!(rec.stages(), vec![read_stage.clone(), read_stage, rows]);
 }

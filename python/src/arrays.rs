@@ -57,6 +57,7 @@ pub fn tangents(
     out_tangents: usize,
     out_bitangents: usize,
 ) -> PyResult<String> {
+    crate::errors::speak_keywords();
     // SAFETY: the addresses and lengths come from arrays the Python side checked and holds.
     let (positions, normals, uvs, index_list) = unsafe {
         (
@@ -196,6 +197,7 @@ pub fn normalmap(
     report: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
+    crate::errors::speak_keywords();
     let usage = |what: &str, v: &str| raise(py, Kind::Usage, format!("{what}={v:?} is not one of bumpbake's"));
     let filter = named(&Filter::ALL, filter).ok_or_else(|| usage("filter", filter))?;
     let wrap = named(&[Wrap::Repeat, Wrap::Clamp, Wrap::Mirror], wrap).ok_or_else(|| usage("wrap", wrap))?;

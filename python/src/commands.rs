@@ -22,6 +22,8 @@ pub fn main(py: Python<'_>, argv: Vec<String>) -> u8 {
             return e.exit_code().clamp(0, 255) as u8;
         }
     };
+    // This process is the command line: its messages name flags.
+    bumpbake::error::install(&cli::wording::Flags);
     cli::process::tune_the_allocator(args.bakes_from_high());
     cli::process::clean_up_on_signals();
     py.detach(|| match cli::run(args) {
@@ -40,6 +42,7 @@ pub fn main(py: Python<'_>, argv: Vec<String>) -> u8 {
 #[pyo3(signature = (argv, progress=None))]
 pub fn run(py: Python<'_>, argv: Vec<String>, progress: Option<Py<PyAny>>) -> PyResult<(u8, String)> {
     let args = cli::Cli::try_parse_from(&argv).map_err(|e| raise(py, Kind::Usage, parse_error(&e)))?;
+    crate::errors::speak_keywords();
     let (reporter, callback) = Callback::reporter(progress);
     let (result, out) = py.detach(|| {
         cli::progress::report_to((!reporter.is_none()).then_some(reporter));

@@ -1,8 +1,59 @@
 //! The library's errors as the package's exceptions (python/bumpbake/_errors.py), worded in
 //! Python's terms: an option is named by its keyword, never by its command-line flag.
 
+use bumpbake::error::{Setting, Wording};
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
+
+/// Settings as the package's keywords: `max_pixels`, `convention="directx"`, `overwrite=True`.
+pub struct Keywords;
+
+impl Wording for Keywords {
+    fn name(&self, s: Setting) -> String {
+        // Every setting by hand, so that a new one fails to build here until it has a keyword.
+        match s {
+            Setting::Convention => "convention",
+            Setting::Material => "material",
+            Setting::MaxPixels => "max_pixels",
+            Setting::AllowOutside => "allow_outside",
+            Setting::Bitangents => "bitangents",
+            Setting::Overwrite => "overwrite",
+            Setting::All => "all",
+            Setting::Ssaa => "ssaa",
+            Setting::Size => "size",
+            Setting::Samples => "samples",
+            Setting::RayFront => "ray_front",
+            Setting::RayBack => "ray_back",
+            Setting::Node => "node",
+            Setting::Bits => "bits",
+            Setting::Alpha => "alpha",
+            Setting::Channel => "channel",
+            Setting::Strength => "strength",
+            Setting::Height => "height",
+            Setting::Normal => "normal",
+            Setting::High => "high",
+        }
+        .to_string()
+    }
+
+    fn given(&self, s: Setting, value: &str) -> String {
+        match value.parse::<f64>() {
+            Ok(_) => format!("{}={value}", self.name(s)),
+            Err(_) => format!("{}={value:?}", self.name(s)),
+        }
+    }
+
+    fn on(&self, s: Setting) -> String {
+        format!("{}=True", self.name(s))
+    }
+}
+
+/// Words the library's messages in keywords from now on in this process. Called by the API's
+/// calls, not at import: the console script imports this module too, and its process is the
+/// command line, which installs its flags (the first wording installed stays).
+pub fn speak_keywords() {
+    bumpbake::error::install(&Keywords);
+}
 
 /// Which exception class of `bumpbake` an error raises.
 #[derive(Clone, Copy)]
@@ -37,13 +88,13 @@ pub fn raise(py: Python<'_>, kind: Kind, msg: impl Into<String>) -> PyErr {
     }
 }
 
-/// A library error as its exception, its words through `words` (the command line's flags turned
-/// into keywords).
+/// A library error as its exception, in [`Keywords`]; `words` then names as keywords any flag the
+/// command line's own checks wrote into it.
 pub fn from_library(py: Python<'_>, e: &bumpbake::Error, words: impl Fn(&str) -> String) -> PyErr {
     let kind = match e {
         bumpbake::Error::Input { .. } => Kind::Input,
-        bumpbake::Error::Usage(_) => Kind::Usage,
+        bumpbake::Error::Usage { .. } => Kind::Usage,
         bumpbake::Error::Output { .. } => Kind::Output,
     };
-    raise(py, kind, words(&e.to_string()))
+    raise(py, kind, words(&e.worded(&Keywords)))
 }

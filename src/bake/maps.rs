@@ -1,7 +1,7 @@
 //! The normal map a material gets: made from a height map with the normalmap command's code, or
 //! taken from a given normal map (turned to glTF's +Y-up convention when it is DirectX).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Setting, Words};
 use crate::normalmap::{self, Channel, Convention, EncodeOptions, Filter, Options, PngSettings, Wrap};
 use crate::scene::{Scene, Slot};
 use std::path::Path;
@@ -78,10 +78,19 @@ pub fn from_normal(path: &Path, declared: Option<Convention>, max_pixels: u64) -
     let confident = confidence >= crate::validate::REPORT_CONFIDENCE && detected.is_some();
     let is_dx = match declared {
         Some(Convention::Directx) if confident && !detected_dx => {
-            return Err(Error::input(path, format!("declared DirectX (-Y), but the map looks like OpenGL (+Y) (confidence {confidence:.2})")))
+            return Err(Error::input(
+                path,
+                format!("declared DirectX (-Y), but the map looks like OpenGL (+Y) (confidence {confidence:.2})"),
+            ))
         }
         Some(Convention::Opengl) if confident && detected_dx => {
-            return Err(Error::input(path, format!("declared OpenGL (+Y), but the map looks like DirectX (-Y) (confidence {confidence:.2}); pass --convention directx to convert it")))
+            let msg = format!(
+                "declared OpenGL (+Y), but the map looks like DirectX (-Y) (confidence {confidence:.2}); pass "
+            );
+            return Err(Error::input(
+                path,
+                Words::from(msg).given(Setting::Convention, "directx").text(" to convert it"),
+            ));
         }
         Some(c) => c == Convention::Directx,
         None => detected_dx && confident,

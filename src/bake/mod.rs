@@ -4,7 +4,7 @@
 
 pub mod maps;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Setting, Words};
 use crate::format::{self, WriteOptions, WriteStats};
 use crate::normalmap::Convention;
 use crate::scene::leave_out::Removal;
@@ -203,7 +203,8 @@ fn attach_maps(
     let chosen: Option<usize> = match &job.material {
         Some(want) => Some(names.iter().position(|n| n.as_deref() == Some(want.as_str())).ok_or_else(|| {
             let have: Vec<String> = names.iter().map(|n| n.clone().unwrap_or_else(|| "(unnamed)".into())).collect();
-            Error::usage(format!("{}: no material named '{want}' (have: {})", job.mesh.display(), have.join(", ")))
+            let msg = format!("{}: no material named '{want}' (have: {})", job.mesh.display(), have.join(", "));
+            Error::setting(Setting::Material, Some(want.clone()), msg)
         })?),
         None => None,
     };
@@ -219,11 +220,12 @@ fn attach_maps(
         (None, _) => {
             let t: Vec<usize> = (0..names.len()).filter(|&m| wants_bump(m)).collect();
             if t.is_empty() {
-                return Err(Error::usage(format!(
-                    "{}: {} materials and none has a bump map; choose one with --material",
+                let msg = format!(
+                    "{}: {} materials and none has a bump map; choose one with ",
                     job.mesh.display(),
                     names.len()
-                )));
+                );
+                return Err(Error::setting(Setting::Material, None, Words::from(msg).name(Setting::Material)));
             }
             t
         }
@@ -295,7 +297,8 @@ fn attach_maps(
         }
     }
     if out.is_empty() {
-        scene.notes.push("no material has a height or normal map: nothing to bake (give --height or --normal)".into());
+        let why = Words::from("no material has a height or normal map: nothing to bake (give ");
+        scene.notes.push(why.name(Setting::Height).text(" or ").name(Setting::Normal).text(")").to_string());
     }
     Ok(out)
 }

@@ -16,6 +16,7 @@ pub mod progress;
 mod tangents;
 mod textures;
 mod validate;
+pub mod wording;
 
 use bumpbake::Result;
 use clap::{Parser, Subcommand};

@@ -16,6 +16,7 @@ thread_local! {
 
 /// Runs `f` with this thread's output collected instead of printed: how a front end that calls
 /// the command line in-process (the Python package's file-level calls) takes its JSON.
+#[allow(dead_code, reason = "the Python binding (python/) compiles this module and calls it")]
 pub fn captured<T>(f: impl FnOnce() -> T) -> (T, Vec<u8>) {
     CAPTURE.with(|c| *c.borrow_mut() = Some(Vec::new()));
     let r = f();

@@ -18,6 +18,7 @@ thread_local! {
 /// Sends the progress of commands run on this thread to `r` instead of bars, until called with
 /// `None`: for a front end that runs the command line in-process and shows progress its own way
 /// (the Python package's `progress=` callable).
+#[allow(dead_code, reason = "the Python binding (python/) compiles this module and calls it")]
 pub fn report_to(r: Option<Reporter>) {
     FRONT_END.with(|f| *f.borrow_mut() = r);
 }
@@ -78,7 +79,7 @@ impl Progress for Bars {
         };
         let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
         b.set_style(ProgressStyle::with_template(template).expect("valid template").progress_chars("=> "));
-        b.set_prefix(stage.to_string());
+        b.set_prefix(super::wording::stage(stage).to_string());
         if unit != "files" {
             b.set_message(unit.to_string());
         }

@@ -1,7 +1,7 @@
 //! Resolving the URIs a glTF or MTL file names: data URIs, and relative files that must stay
 //! inside the asset's folder unless the user allows otherwise.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Setting, Words};
 use base64::Engine as _;
 use std::path::{Component, Path, PathBuf};
 
@@ -43,10 +43,8 @@ pub fn resolve(uri: &str, base_dir: &Path, source: &Path, allow_outside: bool) -
     let decoded = percent_decode(uri);
     let rel = Path::new(&decoded);
     if !allow_outside && escapes(rel) {
-        return Err(Error::input(
-            source,
-            format!("URI '{}' reaches outside the asset's folder (pass --allow-outside to permit)", short(uri)),
-        ));
+        let msg = format!("URI '{}' reaches outside the asset's folder (pass ", short(uri));
+        return Err(Error::input(source, Words::from(msg).on(Setting::AllowOutside).text(" to permit)")));
     }
     Ok(Target::File(base_dir.join(rel)))
 }

@@ -3,6 +3,7 @@
 //! chosen. Luma is taken on the stored values, not linearised: a height map's values are
 //! heights, not light, whatever colour space tag the file carries.
 
+use crate::error::{Setting, Words};
 use image::DynamicImage;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -54,7 +55,9 @@ pub(crate) enum Pick {
 /// Which sample of a `channels`-sample pixel holds the height, or why none does.
 pub(crate) fn pick(channel: Channel, channels: usize, has_alpha: bool, is_colour: bool) -> crate::error::Faulty<Pick> {
     Ok(match channel {
-        Channel::A if !has_alpha => return Err("--channel a, but the image has no alpha channel".into()),
+        Channel::A if !has_alpha => {
+            return Err(Words::new().given(Setting::Channel, "a").text(", but the image has no alpha channel").into())
+        }
         Channel::A => Pick::Index(channels - 1),
         _ if !is_colour => Pick::Index(0),
         Channel::Luma => Pick::Luma,

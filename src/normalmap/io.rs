@@ -4,7 +4,7 @@
 use super::ktx2::LevelError;
 use super::{encode_normals, height_from_image, Channel, Depth, EncodeOptions, HeightPlane, NormalData, NormalImage};
 use super::{Convention, NormalPlane, Options};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Setting, Words};
 use crate::progress::Reporter;
 use crate::timings::Timings;
 use image::{DynamicImage, ExtendedColorType, ImageEncoder};
@@ -213,16 +213,21 @@ impl OutputFormat {
     pub fn depth(self, path: &Path, bits: Option<u8>) -> Result<Depth> {
         match (self, bits) {
             (OutputFormat::Exr, None) => Ok(Depth::Float),
-            (OutputFormat::Exr, Some(_)) => {
-                Err(Error::usage(format!("{}: EXR output is 32-bit float; --bits is for PNG and TIFF", path.display())))
+            (OutputFormat::Exr, Some(b)) => {
+                let msg = Words::from(format!("{}: EXR output is 32-bit float; ", path.display())).name(Setting::Bits);
+                Err(Error::setting(Setting::Bits, Some(b.to_string()), msg.text(" is for PNG and TIFF")))
             }
-            (OutputFormat::Ktx2, Some(16)) => Err(Error::usage(format!(
-                "{}: KTX2 output is 8-bit Basis Universal; --bits 16 is for PNG and TIFF",
-                path.display()
-            ))),
+            (OutputFormat::Ktx2, Some(16)) => {
+                let msg = format!("{}: KTX2 output is 8-bit Basis Universal; ", path.display());
+                let msg = Words::from(msg).given(Setting::Bits, 16).text(" is for PNG and TIFF");
+                Err(Error::setting(Setting::Bits, Some("16".into()), msg))
+            }
             (_, None | Some(8)) => Ok(Depth::Bits8),
             (_, Some(16)) => Ok(Depth::Bits16),
-            (_, Some(b)) => Err(Error::usage(format!("--bits {b}: use 8 or 16"))),
+            (_, Some(b)) => {
+                let msg = Words::new().given(Setting::Bits, b).text(": use 8 or 16");
+                Err(Error::setting(Setting::Bits, Some(b.to_string()), msg))
+            }
         }
     }
 }
@@ -383,10 +388,10 @@ fn filtered_bytes(
 ) -> Result<(Vec<u8>, Option<Vec<LevelError>>)> {
     if format == OutputFormat::Ktx2 {
         if c.encode.alpha_height || c.encode.depth != Depth::Bits8 {
-            return Err(Error::usage(format!(
-                "{}: KTX2 output is an 8-bit RGB normal map (no --alpha, no --bits 16)",
-                c.output.display()
-            )));
+            let msg = format!("{}: KTX2 output is an 8-bit RGB normal map (no ", c.output.display());
+            let msg = Words::from(msg).name(Setting::Alpha).text(", no ").given(Setting::Bits, 16).text(")");
+            let setting = if c.encode.alpha_height { Setting::Alpha } else { Setting::Bits };
+            return Err(Error::setting(setting, None, msg));
         }
         let max = crate::format::image::ktx2::MAX_SIDE as usize;
         if height.width > max || height.height > max {

@@ -7,6 +7,7 @@
 //! warn on exactly the maps `validate` reports as `NORMALMAP_FLAT` or `NORMALMAP_NEARLY_FLAT`.
 
 use super::{HeightPlane, NormalData, NormalImage};
+use crate::error::{Setting, Words};
 use rayon::prelude::*;
 
 /// Up to this largest tilt a map is exactly flat: every texel is `(0, 0, 1)` to within 8-bit
@@ -99,7 +100,7 @@ impl Flatness {
 
     /// A warning for a map made from `h` at `strength` when it came out (nearly) flat, naming a
     /// strength that would show the relief; `scale` turns that into the number the user gives
-    /// (`bake` multiplies `--strength` by an MTL `-bm`).
+    /// (`bake` multiplies [`Setting::Strength`] by an MTL `-bm`).
     pub fn warning(&self, h: &HeightPlane, strength: f32, scale: f32) -> Option<String> {
         let verdict = self.verdict();
         if verdict == Verdict::Relief {
@@ -117,10 +118,9 @@ impl Flatness {
             Verdict::Flat => "flat: every texel rounds to (0, 0, 1)".to_string(),
             _ => format!("nearly flat: its largest tilt is {tilt:.2}° (below {NEARLY_FLAT_DEG:.0}°)"),
         };
-        Some(format!(
-            "the normal map is {what} at strength {strength}; --strength {} would tilt the steepest slope {SUGGESTED_DEG:.0}°",
-            round2(wanted)
-        ))
+        let w = Words::from(format!("the normal map is {what} at strength {strength}; "));
+        let w = w.given(Setting::Strength, round2(wanted));
+        Some(w.text(format!(" would tilt the steepest slope {SUGGESTED_DEG:.0}°")).to_string())
     }
 }
 
@@ -183,7 +183,7 @@ mod tests {
     fn a_ramp_has_its_slope_and_a_strength_that_tilts_it_thirty_degrees() {
         assert!((steepest_slope(&ramp(0.001)) - 0.001).abs() < 1e-7);
         let w = tilted(0.06).warning(&ramp(0.001), 1.0, 1.0).expect("0.06° is flat");
-        assert!(w.contains("--strength 580 "), "{w}");
+        assert!(w.contains("strength=580 "), "{w}");
         assert!(tilted(30.0).warning(&ramp(0.001), 580.0, 1.0).is_none());
         assert!(tilted(0.0).warning(&ramp(0.0), 1.0, 1.0).unwrap().contains("constant"));
     }

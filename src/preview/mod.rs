@@ -32,8 +32,8 @@ pub use shade::{Light, Params, Shading};
 pub use texture::Mips;
 pub use views::View;
 
+use crate::error::{Result, Setting, Words};
 use crate::scene::Scene;
-use crate::Result;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -96,17 +96,17 @@ impl Options {
     /// Checks sizes before any memory is committed to them.
     pub fn check(&self) -> Result<()> {
         if self.width == 0 || self.height == 0 || self.ssaa == 0 || self.ssaa > MAX_SSAA {
-            return Err(crate::Error::usage(format!(
-                "preview: size must be at least 1x1 and --ssaa between 1 and {MAX_SSAA}"
-            )));
+            let msg = Words::from("preview: size must be at least 1x1 and ").name(Setting::Ssaa);
+            let setting = if self.width == 0 || self.height == 0 { Setting::Size } else { Setting::Ssaa };
+            return Err(crate::Error::setting(setting, None, msg.text(format!(" between 1 and {MAX_SSAA}"))));
         }
         let n = self.width as u64 * self.height as u64;
         let row = self.width as u64 * (self.ssaa as u64).pow(2);
         if n > MAX_SAMPLES || row > MAX_SAMPLES {
-            return Err(crate::Error::usage(format!(
-                "preview: {}x{} with --ssaa {} is {n} pixels and {row} samples a row; the limit is {MAX_SAMPLES}",
-                self.width, self.height, self.ssaa
-            )));
+            let msg =
+                Words::from(format!("preview: {}x{} with ", self.width, self.height)).given(Setting::Ssaa, self.ssaa);
+            let msg = msg.text(format!(" is {n} pixels and {row} samples a row; the limit is {MAX_SAMPLES}"));
+            return Err(crate::Error::setting(Setting::Size, Some(format!("{}x{}", self.width, self.height)), msg));
         }
         Ok(())
     }

@@ -7,7 +7,7 @@
 
 use super::refs::{self, Walker};
 use super::{texcoord, PrimRef, Scene};
-use crate::error::Result;
+use crate::error::{Result, Setting, Words};
 use std::collections::HashMap;
 
 /// One thing left out, and the bytes it took.
@@ -99,7 +99,7 @@ impl Scene {
     fn unneeded_attributes(&mut self, keep_bitangents: bool) -> Vec<Removal> {
         // Decided for every primitive first: the materials do not change while attributes go.
         let mats = self.materials();
-        let mut plan: Vec<(PrimRef, Vec<(String, &'static str)>)> = Vec::new();
+        let mut plan: Vec<(PrimRef, Vec<(String, Words)>)> = Vec::new();
         for r in self.primitives() {
             let needs_tangents = mats.tangent_need(self, r).is_some();
             let max_set = mats.uv_sets(self, r).into_iter().next_back();
@@ -108,12 +108,12 @@ impl Scene {
             let mut drop = Vec::new();
             for name in names {
                 let why = if name == "TANGENT" && !needs_tangents {
-                    Some("no normal texture, clearcoat normal texture or anisotropy reads it")
+                    Some(Words::from("no normal texture, clearcoat normal texture or anisotropy reads it"))
                 } else if name == "_BITANGENT" && !keep_bitangents {
-                    Some("not asked for (--bitangents)")
+                    Some(Words::from("not asked for (").name(Setting::Bitangents).text(")"))
                 } else if let Some(k) = name.strip_prefix("TEXCOORD_").and_then(|k| k.parse::<u64>().ok()) {
                     // Only trailing sets go: glTF wants TEXCOORD_0..n without gaps.
-                    (max_set.map(|m| k > m as u64).unwrap_or(true)).then_some("no texture reads it")
+                    (max_set.map(|m| k > m as u64).unwrap_or(true)).then(|| Words::from("no texture reads it"))
                 } else {
                     None
                 };

@@ -219,7 +219,7 @@ impl Scene {
     }
 
     /// An error about this scene's file.
-    pub fn err(&self, msg: impl Into<String>) -> Error {
+    pub fn err(&self, msg: impl Into<crate::error::Words>) -> Error {
         Error::input(&self.source, msg)
     }
 

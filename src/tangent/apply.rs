@@ -7,7 +7,7 @@
 //! Everything else is skipped with a reason the report names.
 
 use super::{with_frames, FrameStats, Options};
-use crate::error::Result;
+use crate::error::{Result, Setting, Words};
 use crate::scene::view::{views, PrimView};
 use crate::scene::{Geometry, PrimRef, Primitive, Scene};
 use rayon::prelude::*;
@@ -55,11 +55,9 @@ pub fn needs_tangents(view: &PrimView, all: bool) -> std::result::Result<(), Str
     }
     let uvs = view.tangent_uvs();
     if !view.has(&uvs.attribute()) {
-        let what = view
-            .tangent_need
-            .as_ref()
-            .map(|n| n.describe())
-            .unwrap_or_else(|| format!("TEXCOORD_{} --all reads", uvs.set));
+        let what = view.tangent_need.as_ref().map(|n| n.describe()).unwrap_or_else(|| {
+            Words::from(format!("TEXCOORD_{} ", uvs.set)).name(Setting::All).text(" reads").to_string()
+        });
         return Err(format!("no UVs (the {what}, which the primitive does not have)"));
     }
     Ok(())
@@ -96,16 +94,16 @@ pub fn apply(scene: &mut Scene, opts: &ApplyOptions) -> Result<Vec<PrimTangents>
                     Some(_) if repaired.is_some() => Some("existing tangents replaced (the normals changed)".into()),
                     Some(t) if !opts.overwrite => match invalid_tangents(t) {
                         0 => {
-                            reports.push(report(
-                                "kept",
-                                Some("valid tangents already present (--overwrite replaces them)".into()),
-                                true,
-                            ));
+                            let kept = Words::from("valid tangents already present (").name(Setting::Overwrite);
+                            let kept = kept.text(" replaces them)");
+                            reports.push(report("kept", Some(kept.to_string()), true));
                             continue;
                         }
                         n => Some(format!("replaced {n} invalid existing tangents (NaN, non-unit, zero or w not +-1)")),
                     },
-                    Some(_) => Some("existing tangents replaced (--overwrite)".into()),
+                    Some(_) => {
+                        Some(Words::from("existing tangents replaced (").name(Setting::Overwrite).text(")").to_string())
+                    }
                     None => None,
                 };
                 let conflicts = view.tangent_need.iter().flat_map(|n| n.conflicts.iter().cloned());

@@ -56,7 +56,7 @@ fn reference(mesh: &TriMesh) -> Frames {
 /// Callers check [`REFERENCE_BUILT_IN`] first (the command line refuses the engine without it).
 #[cfg(not(feature = "reference"))]
 fn reference(_mesh: &TriMesh) -> Frames {
-    panic!("the reference engine (bevy_mikktspace) is not built in: build bumpbake with `--features reference`")
+    panic!("the reference engine (bevy_mikktspace) is not built in: build bumpbake with its `reference` feature")
 }
 
 #[cfg(feature = "reference")]

@@ -8,7 +8,7 @@
 //! through the node's matrix (as three.js, Babylon.js and the glTF sample viewer do), each
 //! normalised per vertex, and `w` negated on a mirroring node.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Setting, Words};
 use crate::format::raw::{part_range, read_raw, RawMesh};
 use crate::scene::nodes::{instances, Instance};
 use crate::scene::to_triangle_list;
@@ -134,10 +134,9 @@ pub fn place(scene: &Scene, prims: &[PrimRef], node: Option<&str>) -> Result<Vec
     if let Some(want) = node {
         let names: Vec<String> = all.iter().filter_map(|i| i.node).map(|n| node_name(scene, n)).collect();
         if !names.iter().any(|n| n == want) {
-            return Err(scene.err(format!(
-                "--node {want}: no node of that name shows a mesh (nodes: {})",
-                if names.is_empty() { "none".to_string() } else { names.join(", ") }
-            )));
+            let have = if names.is_empty() { "none".to_string() } else { names.join(", ") };
+            let msg = format!(": no node of that name shows a mesh (nodes: {have})");
+            return Err(scene.err(Words::new().given(Setting::Node, want).text(msg)));
         }
     }
     let mut out = Vec::new();
@@ -152,13 +151,13 @@ pub fn place(scene: &Scene, prims: &[PrimRef], node: Option<&str>) -> Result<Vec
                 match node.and_then(|w| many.iter().find(|i| i.node.is_some_and(|n| node_name(scene, n) == w))) {
                     Some(i) => Some(**i),
                     None => {
-                        return Err(scene.err(format!(
-                            "LOW mesh '{}' is shown by nodes '{}' (one UV layout in {} places, one map); bake one of them with --node {}",
+                        let msg = format!(
+                            "LOW mesh '{}' is shown by nodes '{}' (one UV layout in {} places, one map); bake one of them with ",
                             mesh_name(scene, r.mesh),
                             names.join("' and '"),
                             names.len(),
-                            names[0]
-                        )))
+                        );
+                        return Err(scene.err(Words::from(msg).given(Setting::Node, &names[0])));
                     }
                 }
             }
@@ -235,9 +234,10 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
         let where_ = format!("mesh {} primitive {}", r.mesh, r.primitive);
         for need in [&uv_set.attribute(), "POSITION", "NORMAL", "TANGENT"] {
             if p.attr(need).is_none() {
-                return Err(scene.err(format!(
-                    "{where_} has no {need}; baking from HIGH needs LOW's UV layout (give LOW UVs, or choose another material with --material)"
-                )));
+                let msg = format!(
+                    "{where_} has no {need}; baking from HIGH needs LOW's UV layout (give LOW UVs, or choose another material with "
+                );
+                return Err(scene.err(Words::from(msg).name(Setting::Material).text(")")));
             }
         }
         let base = out.positions.len() as u32;

@@ -17,7 +17,7 @@ pub mod raster;
 pub mod raycast;
 pub mod report;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Setting, Words};
 use crate::format::raw::RawMesh;
 use crate::normalmap::Convention;
 use crate::progress::Reporter;
@@ -31,6 +31,9 @@ use rayon::prelude::*;
 pub use report::{Counts, TransferReport};
 use report::{HighFile, HighPartReport, MaterialBake, Pair, PartStats};
 use std::path::PathBuf;
+
+/// The progress stage of the rays, in rows of the maps.
+pub const STAGE: &str = "trace rays";
 
 /// Default ray reach on each side of LOW, as a fraction of LOW's bounding-box diagonal.
 pub const DEFAULT_REACH: f64 = 0.05;
@@ -57,7 +60,7 @@ pub struct Settings {
     pub height_out: Option<PathBuf>,
     pub miss_mask: Option<PathBuf>,
     pub read: ReadOptions,
-    /// Told how the rays advance (stage `bake --from`, in rows of the maps).
+    /// Told how the rays advance (stage [`STAGE`], in rows of the maps).
     pub progress: Reporter,
     /// How LOW parts find their HIGH parts.
     pub matching: Match,
@@ -198,7 +201,7 @@ pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<Raw
     let mut mats = Vec::new();
     let mut offset = 0;
     let n_maps = materials.len();
-    s.progress.start("bake --from", (s.height * n_maps) as u64, "rows");
+    s.progress.start(STAGE, (s.height * n_maps) as u64, "rows");
     for (k, &m) in materials.iter().enumerate() {
         let pick: Vec<(Placed, u32)> =
             placed.iter().zip(&low_part).skip(offset).take(per_mat[k].len()).map(|(p, &i)| (p.clone(), i)).collect();
@@ -296,19 +299,24 @@ pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<Raw
 
 fn check(s: &Settings) -> Result<()> {
     if s.highs.is_empty() {
-        return Err(Error::usage("bake --from: give at least one HIGH mesh"));
+        let msg = Words::from("no HIGH mesh to bake from (give at least one as ").name(Setting::High).text(")");
+        return Err(Error::setting(Setting::High, None, msg));
     }
     // About 40 bytes per texel are held while baking: 8192² is 2.7 GB.
     if s.width == 0 || s.height == 0 || s.width > 8192 || s.height > 8192 {
-        return Err(Error::usage("--size: each side must be 1 to 8192 texels"));
+        let size = format!("{}x{}", s.width, s.height);
+        let msg = Words::new().name(Setting::Size).text(": each side must be 1 to 8192 texels");
+        return Err(Error::setting(Setting::Size, Some(size), msg));
     }
     if !(1..=8).contains(&s.samples) {
-        return Err(Error::usage("--samples: 1 to 8 (samples per texel along each axis)"));
+        let msg = Words::new().name(Setting::Samples).text(": 1 to 8 (samples per texel along each axis)");
+        return Err(Error::setting(Setting::Samples, Some(s.samples.to_string()), msg));
     }
-    for (name, v) in [("--ray-front", s.ray_front), ("--ray-back", s.ray_back)] {
+    for (setting, v) in [(Setting::RayFront, s.ray_front), (Setting::RayBack, s.ray_back)] {
         if let Some(v) = v {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::usage(format!("{name} must be a distance >= 0")));
+                let msg = Words::new().name(setting).text(" must be a distance >= 0");
+                return Err(Error::setting(setting, Some(v.to_string()), msg));
             }
         }
     }

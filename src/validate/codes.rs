@@ -1,5 +1,10 @@
 //! The stable check codes, their default severities and fix hints. Codes are part of the
 //! command-line interface (`--deny`, `--allow`) and of the JSON schema: never rename one.
+//!
+//! The fix hints, and the unknown-code message, are advice to a person and name `bumpbake`
+//! commands and their flags: this file is the one place in the library whose strings do
+//! (`tests/layering.rs` allows it). Every other message words its options through
+//! [`crate::error::Setting`].
 
 use std::fmt;
 

@@ -38,7 +38,7 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
             Ok(g) => g,
             Err(e) => {
                 let why = match &e {
-                    crate::Error::Input { msg, .. } => msg.clone(),
+                    crate::Error::Input { msg, .. } => msg.to_string(),
                     other => other.to_string(),
                 };
                 let f = Finding::new(Code::PRIMITIVE_UNREADABLE, 1, 1, "primitives", format!("cannot be read: {why}"));

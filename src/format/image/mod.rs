@@ -19,7 +19,7 @@
 
 pub mod ktx2;
 
-use crate::error::{Fault, Faulty};
+use crate::error::{Fault, Faulty, Setting, Words};
 use image::{DynamicImage, ImageDecoder, ImageError, ImageFormat, ImageReader};
 use std::io::Cursor;
 
@@ -37,8 +37,8 @@ pub struct Limits {
     pub max_pixels: u64,
     /// Bytes the decoder may allocate at once.
     pub max_alloc: u64,
-    /// The command-line option that raises the limit, for the message.
-    pub option: Option<&'static str>,
+    /// The setting that raises the limit, for the message.
+    pub option: Option<Setting>,
 }
 
 impl Limits {
@@ -46,11 +46,11 @@ impl Limits {
     pub const TEXTURE: Limits =
         Limits { max_side: MAX_SIDE, max_pixels: MAX_PIXELS, max_alloc: MAX_ALLOC, option: None };
 
-    /// Image files given on the command line, up to `max_pixels` (`--max-pixels`). The decoder's
+    /// Image files given by the caller, up to `max_pixels` ([`Setting::MaxPixels`]). The decoder's
     /// own buffers are bounded to what that many RGBA float pixels need (16 bytes each).
     pub fn file(max_pixels: u64) -> Limits {
         let max_alloc = max_pixels.saturating_mul(16).max(1 << 24);
-        Limits { max_side: u32::MAX, max_pixels, max_alloc, option: Some("--max-pixels") }
+        Limits { max_side: u32::MAX, max_pixels, max_alloc, option: Some(Setting::MaxPixels) }
     }
 }
 
@@ -283,9 +283,8 @@ pub fn check_size_within(w: u32, h: u32, l: &Limits) -> Faulty<()> {
     }
     let pixels = w as u64 * h as u64;
     if let (Some(option), true) = (l.option, pixels > l.max_pixels) {
-        return Err(
-            format!("image is {w}x{h} = {pixels} pixels, more than the limit of {} ({option})", l.max_pixels).into()
-        );
+        let msg = format!("image is {w}x{h} = {pixels} pixels, more than the limit of {} (", l.max_pixels);
+        return Err(Words::from(msg).name(option).text(")").into());
     }
     if w > l.max_side || h > l.max_side || pixels > l.max_pixels {
         let side = if l.max_side == u32::MAX { String::new() } else { format!("at most {} per side and ", l.max_side) };
@@ -470,7 +469,7 @@ mod tests {
         assert!(check_size_within(100, 100, &Limits::file(9_999))
             .unwrap_err()
             .to_string()
-            .contains("limit of 9999 (--max-pixels)"));
+            .contains("limit of 9999 (max_pixels)"));
     }
 
     #[test]
