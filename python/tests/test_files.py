@@ -158,3 +158,13 @@ def test_the_console_script_and_python_m_run_the_command_line(fixtures):
     assert m.returncode == 0 and "PASS" in m.stderr
     bad = subprocess.run([sys.executable, "-m", "bumpbake", "validate", "missing.glb"], capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.startswith("bumpbake: ")
+
+
+def test_notes_in_the_dicts_name_keywords(tmp_path, fixtures):
+    mirror = fixtures / "khronos/NormalTangentMirrorTest.glb"
+    got = bumpbake.tangents_file(mirror, tmp_path / "m.glb")
+    reason = got["primitives"][0]["reason"]
+    assert "(overwrite replaces them)" in reason and "--" not in reason, reason
+    # The command line words the same note with its flag.
+    want = cli_json("tangents", mirror, "-o", tmp_path / "c.glb", "--json")
+    assert "--overwrite" in want["primitives"][0]["reason"]
