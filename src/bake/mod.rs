@@ -84,9 +84,9 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
 
 /// [`run`] with HIGH meshes already in memory for a [`MapSource::Transfer`] job
 /// ([`crate::transfer::bake_from`]).
-pub fn run_from(job: &BakeJob, high: Vec<crate::format::raw::RawMesh>) -> Result<BakeReport> {
+pub fn run_from(job: &BakeJob, high: Vec<crate::transfer::high::HighMesh>) -> Result<BakeReport> {
     let mut t = Timings::default();
-    let mut scene = t.time("read", || Scene::read(&job.mesh, &job.read))?;
+    let mut scene = t.time("read", || crate::format::read(&job.mesh, &job.read))?;
     let mut deps = scene.dependencies();
     let created = scene.ensure_material();
     let mut warnings = Vec::new();

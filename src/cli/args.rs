@@ -274,13 +274,15 @@ pub struct BatchArgs {
 impl BatchArgs {
     /// How to run `inputs`: a bar over the files when there are several and a person watches.
     pub fn options(&self, inputs: usize) -> BatchOptions {
-        let bar = inputs > 1 && super::progress::wanted(self.progress, self.quiet || self.json);
-        BatchOptions { jobs: self.jobs, progress: super::progress::reporter(bar) }
+        let bar = inputs > 1 && super::progress_bars::wanted(self.progress, self.quiet || self.json);
+        BatchOptions { jobs: self.jobs, progress: super::progress_bars::reporter(bar) }
     }
 
     /// Bars for one input's reads and bakes, when it is the only one and a person watches.
     pub fn single_progress(&self, inputs: usize) -> bumpbake::progress::Reporter {
-        super::progress::reporter(inputs == 1 && super::progress::wanted(self.progress, self.quiet || self.json))
+        super::progress_bars::reporter(
+            inputs == 1 && super::progress_bars::wanted(self.progress, self.quiet || self.json),
+        )
     }
 }
 

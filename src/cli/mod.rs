@@ -1,7 +1,7 @@
 //! Command-line types (clap derive), one file per subcommand, each with its `run`.
 
 #[macro_use]
-mod out;
+mod stdout;
 
 mod args;
 mod bake;
@@ -11,7 +11,7 @@ mod inspect;
 mod normalmap;
 mod preview;
 mod print;
-mod progress;
+mod progress_bars;
 mod tangents;
 mod textures;
 mod validate;

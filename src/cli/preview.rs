@@ -202,7 +202,7 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 fn read(path: &Path, allow_outside: bool) -> Result<Scene> {
-    Scene::read(path, &ReadOptions { allow_outside, ..Default::default() })
+    bumpbake::format::read(path, &ReadOptions { allow_outside, ..Default::default() })
 }
 
 pub fn run(a: Args) -> Result<u8> {

@@ -322,7 +322,7 @@ impl Cx<'_> {
         if !s.has_texture(ti) {
             return Err(s.err(format!("texture {ti} does not exist")));
         }
-        let choice = s.texture_image_to_decode(ti)?;
+        let choice = crate::format::image::texture_image_to_decode(s, ti)?;
         self.notes.extend(choice.note(ti));
         let Some((chosen, bytes)) = choice.chosen else {
             if choice.passed_over.is_empty() {

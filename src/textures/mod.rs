@@ -274,7 +274,7 @@ pub struct TexturesRun {
 
 pub fn run(job: &TexturesJob) -> Result<TexturesRun> {
     let mut t = Timings::default();
-    let mut scene = t.time("read", || Scene::read(&job.input, &job.read))?;
+    let mut scene = t.time("read", || crate::format::read(&job.input, &job.read))?;
     let deps = scene.dependencies();
     let textures = t.time("textures", || ship(&mut scene, &job.options))?;
     let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;

@@ -8,8 +8,8 @@
 //! through the node's matrix (as three.js, Babylon.js and the glTF sample viewer do), each
 //! normalised per vertex, and `w` negated on a mirroring node.
 
+use super::high::{part_range, read_high, HighMesh};
 use crate::error::{Error, Result};
-use crate::format::raw::{part_range, read_raw, RawMesh};
 use crate::scene::nodes::{instances, Instance};
 use crate::scene::to_triangle_list;
 use crate::scene::{smooth_vertex_normals, PrimRef, PrimView, ReadOptions, Scene};
@@ -52,10 +52,10 @@ impl High {
     /// Appends a mesh as read, moving its positions into the frame centred on `origin`; smooth
     /// normals where it has none, per part (each part's primitive has its own vertices). Its
     /// arrays are taken over, not copied, when HIGH is empty.
-    fn append(&mut self, raw: RawMesh, origin: DVec3) {
+    fn append(&mut self, raw: HighMesh, origin: DVec3) {
         let (mut normal_triangles, mut normals) = (raw.normal_triangles, raw.normals);
         let (mut positions, triangles) = (raw.positions, raw.triangles);
-        // RawMesh normals are unit already; only a HIGH without any gets smooth ones, per part.
+        // HighMesh normals are unit already; only a HIGH without any gets smooth ones, per part.
         if normals.is_empty() {
             normal_triangles = Vec::with_capacity(triangles.len());
             for k in 0..raw.parts.len().max(1) {
@@ -274,7 +274,7 @@ pub fn high(
     paths: &[std::path::PathBuf],
     read: &ReadOptions,
     origin: DVec3,
-    given: Vec<RawMesh>,
+    given: Vec<HighMesh>,
 ) -> Result<(High, Vec<usize>, Vec<HighPart>)> {
     let mut h = High::default();
     let mut counts = Vec::new();
@@ -283,7 +283,7 @@ pub fn high(
     for (f, path) in paths.iter().enumerate() {
         let raw = match given.next() {
             Some(m) => m,
-            None => read_raw(path, read)?,
+            None => read_high(path, read)?,
         };
         if raw.triangles.is_empty() {
             return Err(Error::input(path, "has no triangles to bake from (HIGH must be a triangle mesh)"));
@@ -313,7 +313,7 @@ pub fn cage(
     placed: &[Placed],
     low: &Low,
 ) -> Result<Vec<[Vec3A; 3]>> {
-    let scene = Scene::read(path, read)?;
+    let scene = crate::format::read(path, read)?;
     let prims: Vec<PrimRef> =
         scene.primitives().into_iter().filter(|&r| crate::scene::view::is_surface(&scene, r)).collect();
     let same = placed.iter().all(|p| prims.contains(&p.prim));

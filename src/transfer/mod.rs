@@ -10,6 +10,7 @@
 
 pub mod bvh;
 pub mod files;
+pub mod high;
 pub mod mesh;
 pub mod pad;
 pub mod parts;
@@ -18,12 +19,12 @@ pub mod raycast;
 pub mod report;
 
 use crate::error::{Error, Result};
-use crate::format::raw::RawMesh;
 use crate::normalmap::Convention;
 use crate::progress::Reporter;
 use crate::scene::{PrimRef, ReadOptions, Scene};
 use crate::timings::Timings;
 use glam::{Mat3A, Vec3A};
+use high::HighMesh;
 use mesh::{High, Low, Placed};
 pub use parts::Match;
 use raster::{Edges, UvTri};
@@ -168,10 +169,10 @@ pub fn bake(scene: &Scene, materials: &[usize], s: &Settings) -> Result<Baked> {
     bake_from(scene, materials, s, Vec::new())
 }
 
-/// [`bake`] with HIGH meshes already in memory, as [`read_raw`](crate::format::raw) hands them
+/// [`bake`] with HIGH meshes already in memory, as [`read_high`](crate::transfer::high) hands them
 /// over: they stand for the first of `s.highs` (whose names then only label the report), and
 /// the rest are read.
-pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<RawMesh>) -> Result<Baked> {
+pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<HighMesh>) -> Result<Baked> {
     check(s)?;
     let mut t = Timings::default();
     let per_mat: Vec<Vec<PrimRef>> = materials.iter().map(|&m| material_prims(scene, m)).collect();
