@@ -10,7 +10,7 @@
 
 use super::high::{part_range, read_high, HighMesh};
 use crate::error::{Error, Result};
-use crate::scene::nodes::{instances, Instance};
+use crate::scene::nodes::{instances, Instance, Placement};
 use crate::scene::to_triangle_list;
 use crate::scene::{smooth_vertex_normals, PrimRef, PrimView, ReadOptions, Scene};
 use glam::{DVec3, Mat4, Vec3, Vec3A};
@@ -104,8 +104,8 @@ pub struct HighPart {
 #[derive(Debug, Clone)]
 pub struct Placed {
     pub prim: PrimRef,
-    /// `None` at identity (kept bit for bit).
-    pub world: Option<Mat4>,
+    /// How the node places it; `None` at identity (kept bit for bit).
+    pub placement: Option<Placement>,
     /// The part: the node's name, else the mesh's.
     pub part: String,
 }
@@ -163,14 +163,10 @@ pub fn place(scene: &Scene, prims: &[PrimRef], node: Option<&str>) -> Result<Vec
                 }
             }
         };
-        let part = inst
-            .and_then(|i| i.node)
-            .and_then(|n| scene.array("nodes").get(n))
-            .and_then(|n| n.get("name"))
-            .and_then(|s| s.as_str());
+        let part = inst.and_then(|i| i.node).and_then(|n| scene.node_name(n));
         out.push(Placed {
             prim: r,
-            world: inst.map(|i| i.world).filter(|w| *w != Mat4::IDENTITY),
+            placement: inst.filter(|i| i.world != Mat4::IDENTITY).map(|i| i.placement()),
             part: part.map_or_else(|| mesh_name(scene, r.mesh), str::to_string),
         });
     }
@@ -195,12 +191,9 @@ pub fn low_parts(placed: &[Placed]) -> (Vec<String>, Vec<u32>) {
 
 fn world_positions(scene: &Scene, p: &Placed) -> Result<Vec<DVec3>> {
     let pos = scene.primitive(p.prim)?.positions();
-    Ok(match p.world {
+    Ok(match &p.placement {
         None => pos.into_iter().map(dvec).collect(),
-        Some(m) => {
-            let m = m.as_dmat4();
-            pos.into_iter().map(|q| m.transform_point3(dvec(q))).collect()
-        }
+        Some(place) => pos.into_iter().map(|q| place.point_f64(dvec(q))).collect(),
     })
 }
 
@@ -244,13 +237,12 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
         out.positions.extend(world_positions(scene, pl)?.into_iter().map(|q| local(q, origin)));
         let normals = g.normals().unwrap_or_default();
         let tangents: Vec<[f32; 4]> = g.tangents().unwrap_or_default();
-        match pl.world {
+        match &pl.placement {
             None => {
                 out.normals.extend(normals.iter().map(|&n| Vec3A::from(n)));
                 out.tangents.extend(tangents);
             }
-            Some(m) => {
-                let place = Instance { mesh: r.mesh, node: None, world: m }.placement();
+            Some(place) => {
                 out.normals
                     .extend(normals.iter().map(|&n| Vec3A::from(place.normal(Vec3::from(n))).normalize_or_zero()));
                 out.tangents.extend(tangents.into_iter().map(|t| {
