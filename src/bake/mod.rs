@@ -41,8 +41,8 @@ pub struct BakeJob {
     pub read: ReadOptions,
     pub write: WriteOptions,
     pub depfile: Option<PathBuf>,
-    /// Ship the textures as KTX2 ([`crate::textures::ship`]); `None`: as made (PNG).
-    pub textures: Option<crate::textures::ShipOptions>,
+    /// Re-encode the normal textures as KTX2 ([`crate::textures::encode_ktx2`]); `None`: as made (PNG).
+    pub textures: Option<crate::textures::EncodeOptions>,
 }
 
 #[derive(Debug, Clone, serde::Serialize)]
@@ -116,7 +116,7 @@ pub fn run_from(job: &BakeJob, high: Vec<crate::transfer::high::HighMesh>) -> Re
     };
     let removed = if job.keep_all { Vec::new() } else { t.time("leave-out", || scene.leave_out(job.bitangents))? };
     let textures = match &job.textures {
-        Some(o) => Some(t.time("textures", || crate::textures::ship(&mut scene, o))?),
+        Some(o) => Some(t.time("textures", || crate::textures::encode_ktx2(&mut scene, o))?),
         None => None,
     };
     let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;

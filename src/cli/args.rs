@@ -5,7 +5,7 @@ use bumpbake::batch::{self, BatchOptions};
 use bumpbake::format::image::ktx2::Codec;
 use bumpbake::normalmap::specular_aa::DEFAULT_THRESHOLD;
 use bumpbake::normalmap::{self as nm, Channel, Convention, Filter, Wrap};
-use bumpbake::textures::ShipOptions;
+use bumpbake::textures::EncodeOptions;
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -151,7 +151,7 @@ impl Ktx2Args {
 
 /// How glTF textures ship as KTX2 (`bake --textures ktx2`, `textures`).
 #[derive(clap::Args, Debug)]
-pub struct ShipArgs {
+pub struct TextureEncodeArgs {
     #[command(flatten)]
     pub ktx2: Ktx2Args,
     /// Keep each PNG/JPEG as the texture's source for clients without KTX2
@@ -170,13 +170,13 @@ pub struct ShipArgs {
     pub specular_aa_threshold: Option<f32>,
 }
 
-impl ShipArgs {
-    pub fn options(&self) -> Result<ShipOptions> {
+impl TextureEncodeArgs {
+    pub fn options(&self) -> Result<EncodeOptions> {
         let threshold = self.specular_aa_threshold.unwrap_or(DEFAULT_THRESHOLD);
         if !(0.0..=1.0).contains(&threshold) {
             return Err(Error::usage(format!("--specular-aa-threshold {threshold}: give a number from 0 to 1")));
         }
-        Ok(ShipOptions {
+        Ok(EncodeOptions {
             codec: self.ktx2.codec()?,
             fallback: self.ktx2_fallback,
             specular_aa: !self.no_specular_aa,
