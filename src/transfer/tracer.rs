@@ -11,7 +11,7 @@ use rayon::prelude::*;
 /// Texel rows rasterised together.
 const BAND: usize = 8;
 
-/// Whether a texel's samples lie on LOW, in the order a texel's samples raise it.
+/// How far a texel's samples found LOW; ordered, so that a texel keeps the best any sample gave.
 #[derive(Clone, Copy, Default, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub(super) enum Coverage {
     /// No sample: left for the padding.
@@ -39,7 +39,7 @@ pub(super) struct Texel {
 /// What the rays of one material's map share: LOW, HIGH's trees, and how far a ray reaches.
 pub(super) struct Tracer<'a> {
     pub(super) low: &'a Low,
-    /// HIGH's trees, one per set of HIGH parts its LOW parts meet.
+    /// HIGH's trees, one per set of HIGH parts (`low_set` picks a LOW part's).
     pub(super) trees: &'a [bvh::Bvh],
     /// Per LOW part, the set of HIGH parts its rays meet.
     pub(super) low_set: &'a [usize],
