@@ -130,13 +130,12 @@ pub fn from_scene(scene: &Scene) -> Result<HighMesh> {
         let prims = mesh_json.get("primitives").and_then(|p| p.as_array()).map_or(0, |p| p.len());
         for k in 0..prims {
             let r = PrimRef { mesh: inst.mesh, primitive: k };
-            let pj = scene.prim_json(r);
             if !crate::scene::view::is_surface(scene, r) {
                 continue;
             }
             let p = to_triangle_list(scene.primitive(r)?);
             let base = out.positions.len() as u32;
-            let material = pj.get("material").and_then(|m| m.as_u64()).map(|m| m.to_string());
+            let material = scene.material_index(r).map(|m| m.to_string());
             out.parts.push(Part { name: name.clone(), material, start: out.triangles.len() as u32 });
             out.positions.extend(p.positions().into_iter().map(|q| place.point(Vec3::from(q)).to_array()));
             match p.attr("NORMAL") {
