@@ -334,21 +334,10 @@ impl Error {
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
-/// Attaches the file name to errors from lower layers that do not know it.
-pub trait Context<T> {
-    fn in_file(self, path: &Path) -> Result<T>;
-}
-
-impl<T, E: std::fmt::Display> Context<T> for std::result::Result<T, E> {
-    fn in_file(self, path: &Path) -> Result<T> {
-        self.map_err(|e| Error::input(path, e.to_string()))
-    }
-}
-
 /// What went wrong inside some bytes, before the caller knows which file they came from: the
 /// words a user reads and, where a library reported it, the error underneath (kept as the
 /// `source`, so the chain is there for whoever walks it). The readers' and decoders' error;
-/// [`Context::in_file`] turns it into an [`Error`] that names the file.
+/// [`Error::in_file`] turns it into an [`Error`] that names the file.
 #[derive(Debug, thiserror::Error)]
 #[error("{msg}")]
 pub struct Fault {

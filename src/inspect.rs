@@ -141,7 +141,7 @@ pub struct ImageInfo {
 }
 
 pub fn inspect(path: &Path, opts: &ReadOptions) -> Result<Inspection> {
-    let scene = Scene::read(path, opts)?;
+    let scene = crate::format::read(path, opts)?;
     let arr = |k: &str| scene.json.get(k).and_then(|v| v.as_array()).cloned().unwrap_or_default();
     let mats = scene.materials().clone();
     let mut primitives = Vec::new();

@@ -1,5 +1,7 @@
 //! Timing of pipeline stages (each command's report carries its `Timings`), and memory marks.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// Wall-clock time of named stages, in the order they ran.
@@ -18,15 +20,41 @@ impl Timings {
     }
 }
 
-/// With `BUMPBAKE_MEMTRACE` set, prints the process's resident and peak memory after `stage` to
-/// stderr (Linux only): how the memory figures in `docs/tangents-bench.md` were found.
+/// Resident and peak memory of the process after a stage, in KiB (Linux: `/proc/self/status`'s
+/// `VmRSS` and `VmHWM`; 0 where it cannot be read).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MemoryMark {
+    pub stage: String,
+    pub rss_kib: u64,
+    pub peak_kib: u64,
+}
+
+static TRACING: AtomicBool = AtomicBool::new(false);
+static MARKS: Mutex<Vec<MemoryMark>> = Mutex::new(Vec::new());
+
+/// From now on, [`mem_mark`] records the process's memory after each stage, for
+/// [`memory_marks`]: how the memory figures in `docs/tangents-bench.md` were found. A profiling
+/// switch for the whole process, as the stages that mark memory are deep inside the engines.
+pub fn trace_memory() {
+    TRACING.store(true, Ordering::Relaxed);
+}
+
+/// The marks recorded since [`trace_memory`], in the order the stages ran (taken: a second call
+/// returns only later ones).
+pub fn memory_marks() -> Vec<MemoryMark> {
+    std::mem::take(&mut *MARKS.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// Records the process's memory after `stage`, once [`trace_memory`] was called; else nothing.
 pub fn mem_mark(stage: &str) {
-    if std::env::var_os("BUMPBAKE_MEMTRACE").is_none() {
+    if !TRACING.load(Ordering::Relaxed) {
         return;
     }
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    let field = |k: &str| {
-        status.lines().find(|l| l.starts_with(k)).map(|l| l[k.len()..].trim().to_string()).unwrap_or_default()
+    let kib = |k: &str| {
+        let line = status.lines().find(|l| l.starts_with(k));
+        line.and_then(|l| l[k.len()..].split_whitespace().next()?.parse().ok()).unwrap_or(0)
     };
-    eprintln!("memtrace {stage}: rss {} peak {}", field("VmRSS:"), field("VmHWM:"));
+    let mark = MemoryMark { stage: stage.to_string(), rss_kib: kib("VmRSS:"), peak_kib: kib("VmHWM:") };
+    MARKS.lock().unwrap_or_else(|e| e.into_inner()).push(mark);
 }

@@ -111,10 +111,10 @@ fn mutated_draco_streams_are_decoded_or_refused() {
         let name = f.file_name().unwrap().to_str().unwrap().to_string();
         let src = std::fs::read(&f).unwrap();
         let t = Instant::now();
-        let (points, faces) = bumpbake::format::draco::decode_and_read(&src).unwrap();
+        let (points, faces) = bumpbake::format::gltf::draco::decode_and_read(&src).unwrap();
         let whole = t.elapsed();
         let (tally, panics) = campaign(&name, src, |b| {
-            bumpbake::format::draco::decode_and_read(b).map(|_| ()).map_err(|e| e.to_string())
+            bumpbake::format::gltf::draco::decode_and_read(b).map(|_| ()).map_err(|e| e.to_string())
         });
         eprintln!("{name}: {points} points, {faces} faces, decoded in {whole:?}; {} mutants: {tally:?}", mutants());
         assert_eq!(tally.ok + tally.error + tally.panic, mutants());
@@ -180,12 +180,12 @@ fn mutated_draco_streams_inside_their_files_are_read_or_refused_in_one_line() {
         // The file rebuilt around its own stream reads as the original does.
         let opts = bumpbake::scene::ReadOptions::default();
         let path = Path::new("/nonexistent-bumpbake/in.glb");
-        bumpbake::scene::Scene::read_bytes(path, &glb.with(&glb.stream()), &opts).unwrap();
+        bumpbake::format::read_bytes(path, &glb.with(&glb.stream()), &opts).unwrap();
         let g = glb.clone();
         let (tally, panics) = campaign(f, glb.stream(), move |b| {
             let path = Path::new("/nonexistent-bumpbake/in.glb");
             let scene =
-                bumpbake::scene::Scene::read_bytes(path, &g.with(b), &Default::default()).map_err(|e| e.to_string())?;
+                bumpbake::format::read_bytes(path, &g.with(b), &Default::default()).map_err(|e| e.to_string())?;
             for r in scene.primitives() {
                 scene.primitive(r).map_err(|e| e.to_string())?;
             }
@@ -203,7 +203,7 @@ fn a_broken_stream_is_one_line_naming_the_file_and_the_primitive() {
     let glb = Glb::read(&root().join("fixtures/real/mirror_small.draco.glb"));
     let stream = glb.stream();
     let path = Path::new("/nonexistent-bumpbake/broken.glb");
-    let e = bumpbake::scene::Scene::read_bytes(path, &glb.with(&stream[..stream.len() / 2]), &Default::default())
+    let e = bumpbake::format::read_bytes(path, &glb.with(&stream[..stream.len() / 2]), &Default::default())
         .err()
         .unwrap()
         .to_string();
@@ -218,7 +218,7 @@ fn read_changed(f: impl FnOnce(&mut serde_json::Value)) -> Result<bumpbake::scen
     f(&mut glb.json);
     let stream = glb.stream();
     let path = Path::new("/nonexistent-bumpbake/changed.glb");
-    bumpbake::scene::Scene::read_bytes(path, &glb.with(&stream), &Default::default()).map_err(|e| e.to_string())
+    bumpbake::format::read_bytes(path, &glb.with(&stream), &Default::default()).map_err(|e| e.to_string())
 }
 
 fn positions(scene: &bumpbake::scene::Scene, primitive: usize) -> Vec<[f32; 3]> {
@@ -286,7 +286,7 @@ fn bake_from_reads_a_draco_low_and_high_and_writes_the_same_counts_as_the_plain_
         let out = d.join(out);
         let (low, high) = (plain.join(low), plain.join(high));
         run_ok(&["bake", s(&low), "--from", s(&high), "-o", s(&out), "--size", "64", "-q"]);
-        let scene = bumpbake::scene::Scene::read(&out, &Default::default()).unwrap();
+        let scene = bumpbake::format::read(&out, &Default::default()).unwrap();
         assert!(!scene.json.to_string().contains("KHR_draco_mesh_compression"));
         let p = scene.primitive(bumpbake::scene::PrimRef { mesh: 0, primitive: 0 }).unwrap();
         assert!(p.attr("TANGENT").is_some(), "{}", out.display());

@@ -44,7 +44,7 @@ fn ktx2_of(path: &Path) -> Vec<(String, Vec<u8>)> {
     if path.extension().is_some_and(|e| e == "ktx2") {
         return vec![(name, std::fs::read(path).unwrap())];
     }
-    let Ok(scene) = bumpbake::scene::Scene::read(path, &Default::default()) else { return Vec::new() };
+    let Ok(scene) = bumpbake::format::read(path, &Default::default()) else { return Vec::new() };
     let count = scene.json.get("images").and_then(|i| i.as_array()).map_or(0, |a| a.len());
     (0..count)
         .filter_map(|i| scene.image_bytes(i).ok().map(|b| (format!("{name} image {i}"), b)))

@@ -2,7 +2,9 @@
 //! "Module map"): these tests read the sources and fail on a clap type or a printout in the
 //! library, an import from a higher layer, or a circle of file imports.
 //!
-//! Code under `#[cfg(test)]` is left out: a test may reach anything it checks against.
+//! Items under `#[cfg(test)]` (test modules, inline or in files of their own) are left out: a
+//! test may reach anything it checks against. The rest of each file is checked, also after an
+//! inner test module.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -29,11 +31,108 @@ fn files() -> Vec<String> {
     out
 }
 
-/// The file's code: its tests cut off and comments dropped.
+/// The file's code: comments dropped, and every item under `#[cfg(test)]` (a test module, inline
+/// or in a file of its own, a test helper) cut out, by matching its braces: production code after
+/// an inner test module is still checked.
 fn code(file: &str) -> String {
     let text = std::fs::read_to_string(src().join(file)).unwrap();
-    let text = text.split("#[cfg(test)]").next().unwrap();
-    text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n")
+    let text = text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n");
+    without_test_items(&text).0
+}
+
+/// `text` without its `#[cfg(test)]` items, and the `#[path]` (or, else, the name) of each test
+/// module declared in a file of its own (`#[cfg(test)] mod tests;`).
+fn without_test_items(text: &str) -> (String, Vec<String>) {
+    const MARK: &str = "#[cfg(test)]";
+    let (mut out, mut test_files, mut rest) = (String::new(), Vec::new(), text);
+    while let Some(i) = rest.find(MARK) {
+        out.push_str(&rest[..i]);
+        let item = &rest[i + MARK.len()..];
+        let end = item_end(item);
+        let decl = &item[..end];
+        if decl.trim_end().ends_with(';') {
+            if let Some(p) = decl.split("#[path = \"").nth(1).and_then(|p| p.split('"').next()) {
+                test_files.push(p.to_string());
+            } else if let Some(name) = decl.split("mod ").nth(1) {
+                test_files.push(format!("{}.rs", name.trim_end().trim_end_matches(';').trim()));
+            }
+        }
+        rest = &item[end..];
+    }
+    out.push_str(rest);
+    (out, test_files)
+}
+
+/// Where the item at the start of `s` ends: after its `;` (or `,`, for a field) or, when a `{`
+/// comes first, after the matching `}` (strings and character literals skipped, so their braces do not count).
+fn item_end(s: &str) -> usize {
+    let b = s.as_bytes();
+    let (mut i, mut depth) = (0, 0usize);
+    // The item's own attributes (`#[path = "..."]`) come first.
+    loop {
+        while i < b.len() && b[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        if b.get(i) == Some(&b'#') {
+            i += s[i..].find(']').map_or(s.len() - i, |j| j + 1);
+        } else {
+            break;
+        }
+    }
+    while i < b.len() {
+        match b[i] {
+            b'"' => {
+                i += 1;
+                while i < b.len() && b[i] != b'"' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+            }
+            b'\'' if b.get(i + 2) == Some(&b'\'') => i += 2,
+            b'\'' if b.get(i + 1) == Some(&b'\\') => i += s[i + 3..].find('\'').map_or(s.len() - i, |j| j + 3),
+            b';' | b',' if depth == 0 => return i + 1,
+            // The end of the enclosing block: the item was a field or an expression.
+            b'}' if depth == 0 => return i,
+            b'{' => depth += 1,
+            b'}' => {
+                depth -= 1;
+                if depth == 0 {
+                    return i + 1;
+                }
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    s.len()
+}
+
+/// Files that only tests compile: the test modules other files declare as files of their own.
+fn test_only_files() -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for f in files() {
+        let text = std::fs::read_to_string(src().join(&f)).unwrap();
+        let dir = match f.rsplit_once('/') {
+            Some((d, "mod.rs")) => d.to_string(),
+            Some((d, name)) => format!("{d}/{}", name.trim_end_matches(".rs")),
+            None if f == "lib.rs" || f == "main.rs" => String::new(),
+            None => f.trim_end_matches(".rs").to_string(),
+        };
+        // `#[path]` is relative to the declaring file's folder; a plain `mod x;` of a non-mod
+        // file lives in the folder named after it.
+        let here = f.rsplit_once('/').map_or(String::new(), |(d, _)| d.to_string());
+        let (_, declared) = without_test_items(&text);
+        for d in declared {
+            let base = if text.contains(&format!("#[path = \"{d}\"]")) { &here } else { &dir };
+            out.insert(if base.is_empty() { d } else { format!("{base}/{d}") });
+        }
+    }
+    out
+}
+
+/// The files whose code the rules read: all but those only tests compile.
+fn checked_files() -> Vec<String> {
+    let tests = test_only_files();
+    files().into_iter().filter(|f| !tests.contains(f)).collect()
 }
 
 fn in_binary(file: &str) -> bool {
@@ -42,7 +141,7 @@ fn in_binary(file: &str) -> bool {
 
 #[test]
 fn clap_is_only_in_the_command_line() {
-    let offenders: Vec<String> = files()
+    let offenders: Vec<String> = checked_files()
         .into_iter()
         .filter(|f| !in_binary(f))
         .filter(|f| code(f).split(|c: char| !c.is_alphanumeric() && c != '_').any(|w| w == "clap"))
@@ -53,18 +152,32 @@ fn clap_is_only_in_the_command_line() {
 /// What the library returns is printed by `cli/print` and `cli/bench`, never by the library.
 #[test]
 fn the_library_prints_no_text_tables_or_plots() {
-    // BUMPBAKE_MEMTRACE=1 lines on stderr: a diagnostic for profiling, which `bench` reads back.
-    const EXCEPTIONS: [&str; 1] = ["timings.rs"];
     let words = ["println!", "print!", "eprintln!", "eprint!", "stdout()", "stderr()", "<svg"];
-    let offenders: Vec<(String, &str)> = files()
+    let offenders: Vec<(String, &str)> = checked_files()
         .into_iter()
-        .filter(|f| !in_binary(f) && !EXCEPTIONS.contains(&f.as_str()))
+        .filter(|f| !in_binary(f))
         .flat_map(|f| {
             let c = code(&f);
             words.iter().filter(|w| c.contains(*w)).map(|w| (f.clone(), *w)).collect::<Vec<_>>()
         })
         .collect();
     assert!(offenders.is_empty(), "printing in the library: {offenders:?}");
+}
+
+/// Settings reach the library as data (options, jobs), never from the process's environment: a
+/// caller from Python or Blender sees every switch. The command line may read the environment.
+#[test]
+fn the_library_reads_no_environment() {
+    let words = ["env::var", "env::vars", "env::args", "var_os(", "option_env!", "env::current_dir"];
+    let offenders: Vec<(String, &str)> = checked_files()
+        .into_iter()
+        .filter(|f| !in_binary(f))
+        .flat_map(|f| {
+            let c = code(&f);
+            words.iter().filter(|w| c.contains(*w)).map(|w| (f.clone(), *w)).collect::<Vec<_>>()
+        })
+        .collect();
+    assert!(offenders.is_empty(), "environment reads in the library: {offenders:?}");
 }
 
 /// The layer of a top-level module of the library (the first part of its path).
@@ -145,7 +258,7 @@ fn paths_after(code: &str, prefix: &str) -> Vec<Vec<String>> {
 fn imports_flow_downward() {
     const EXCEPTIONS: [(&str, &str); 0] = [];
     let mut offenders = Vec::new();
-    for f in files().into_iter().filter(|f| !in_binary(f) && f.contains('/') || f == "inspect.rs") {
+    for f in checked_files().into_iter().filter(|f| !in_binary(f) && f != "lib.rs") {
         let own = f.split(['/', '.']).next().unwrap();
         let own_layer = layer(own).unwrap_or_else(|| panic!("{f}: module {own} has no layer in this test"));
         for p in paths_after(&code(&f), "crate") {
@@ -198,7 +311,7 @@ fn module_of(file: &str) -> Vec<String> {
 /// The files each file imports from, by `crate::`, `super::` and (in the binary) `bumpbake::`.
 fn import_graph() -> BTreeMap<String, BTreeSet<String>> {
     let mut g = BTreeMap::new();
-    for f in files() {
+    for f in checked_files() {
         let c = code(&f);
         let here = module_of(&f);
         let mut to = BTreeSet::new();
@@ -313,6 +426,17 @@ fn the_rules_see_their_targets() {
     assert_eq!(file_of("", &["scene".into(), "view".into(), "Geometry".into()]).as_deref(), Some("scene/view.rs"));
     assert!(parent_and_child("cli/bench/tangents.rs", "cli/bench/tangents/plot.rs"));
     assert!(!parent_and_child("cli/bench/tangents.rs", "cli/bench/normalmap.rs"));
+    let inner = "fn a() {}\n#[cfg(test)]\nmod tests {\n    fn b() { let s = \"}\"; let c = '{'; }\n}\nfn after() { crate::x::y(); }\n#[cfg(test)]\n#[path = \"t.rs\"]\nmod more;\nfn last() {}";
+    let (kept, declared) = without_test_items(inner);
+    assert!(kept.contains("fn a()") && kept.contains("fn after()") && kept.contains("fn last()"), "{kept}");
+    assert!(!kept.contains("fn b()") && !kept.contains("mod more"), "{kept}");
+    assert_eq!(declared, vec!["t.rs"]);
+    let tests = test_only_files();
+    assert!(tests.contains("format/obj/parse_tests.rs") && tests.contains("format/ply/tests.rs"), "{tests:?}");
+    // Production code after an inner test module, and a `#[cfg(test)]` method left out.
+    assert!(code("scene/normals.rs").contains("fn repair_normals"), "code after an inner test module is read");
+    let filter = code("normalmap/filter.rs");
+    assert!(filter.contains("fn vertical") && !filter.contains("fn row("), "test-only items cut, the rest kept");
     let g = import_graph();
     assert!(g["cli/bench/tangents/plot.rs"].contains("cli/bench/tangents.rs"), "{:?}", g["cli/bench/tangents/plot.rs"]);
     assert!(g["bake/maps.rs"].contains("validate/mod.rs"), "{:?}", g["bake/maps.rs"]);

@@ -449,7 +449,7 @@ fn write_obj_references() {
     for (obj, out) in
         [("spot/spot.obj", "spot/spot.tangents.txt"), ("blub/blub_triangulated.obj", "blub/blub.tangents.txt")]
     {
-        let scene = Scene::read(&dir.join(obj), &ReadOptions::default()).expect("fixture reads");
+        let scene = bumpbake::format::read(&dir.join(obj), &ReadOptions::default()).expect("fixture reads");
         let p = scene.primitive(scene.primitives()[0]).expect("primitive 0");
         let positions = p.positions();
         let normals: Vec<[f32; 3]> = p.attr("NORMAL").expect("normals").to_f32();

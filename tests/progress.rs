@@ -5,7 +5,7 @@
 use bumpbake::bake::{BakeJob, MapSource};
 use bumpbake::batch::{self, BatchOptions};
 use bumpbake::progress::{Progress, Reporter};
-use bumpbake::scene::{ReadOptions, Scene};
+use bumpbake::scene::ReadOptions;
 use bumpbake::transfer::Settings;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -78,7 +78,7 @@ fn obj_read_ticks_every_byte_once() {
     let rec = Recording::default();
     let path = fixture("spot/spot.obj");
     let opts = ReadOptions { progress: Reporter::new(rec.clone()), ..Default::default() };
-    Scene::read(&path, &opts).unwrap();
+    bumpbake::format::read(&path, &opts).unwrap();
     let bytes = std::fs::metadata(&path).unwrap().len();
     assert_eq!(rec.stages(), vec![("read spot.obj".to_string(), bytes, "bytes".to_string(), bytes)]);
     assert!(rec.calls().iter().filter(|c| matches!(c, Call::Tick(_))).count() > 1, "ticks as it parses");
@@ -89,7 +89,7 @@ fn glb_read_reports_nothing() {
     // Fast to read whatever its size: nothing to wait for.
     let rec = Recording::default();
     let opts = ReadOptions { progress: Reporter::new(rec.clone()), ..Default::default() };
-    Scene::read(&fixture("khronos/NormalTangentTest.glb"), &opts).unwrap();
+    bumpbake::format::read(&fixture("khronos/NormalTangentTest.glb"), &opts).unwrap();
     assert_eq!(rec.calls(), vec![]);
 }
 
@@ -193,5 +193,5 @@ fn only_the_command_line_draws() {
         .filter(|f| std::fs::read_to_string(f).unwrap().contains("indicatif"))
         .map(|f| f.strip_prefix(&src).unwrap().display().to_string())
         .collect();
-    assert_eq!(drawing, ["cli/progress.rs"], "indicatif is used only in src/cli/progress.rs");
+    assert_eq!(drawing, ["cli/progress_bars.rs"], "indicatif is used only in src/cli/progress_bars.rs");
 }

@@ -3,14 +3,14 @@
 // that every tangent written obeys the conventions.
 
 use bumpbake::format::WriteOptions;
-use bumpbake::scene::{ReadOptions, Scene};
+use bumpbake::scene::ReadOptions;
 use bumpbake::tangent::apply::{apply, ApplyOptions};
 use std::path::Path;
 
 pub fn exercise(path: &str, data: &[u8]) {
     // A folder that does not exist: relative URIs the input names resolve to nothing.
     let path = Path::new(path);
-    let Ok(mut scene) = Scene::read_bytes(path, data, &ReadOptions::default()) else { return };
+    let Ok(mut scene) = bumpbake::format::read_bytes(path, data, &ReadOptions::default()) else { return };
     for r in scene.primitives() {
         let _ = scene.primitive(r);
     }

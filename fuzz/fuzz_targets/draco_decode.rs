@@ -5,7 +5,7 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok((points, faces)) = bumpbake::format::draco::decode_and_read(data) {
+    if let Ok((points, faces)) = bumpbake::format::gltf::draco::decode_and_read(data) {
         assert!(points <= 1 << 20 && faces <= 1 << 20, "inside the fuzzing limits");
     }
 });

@@ -82,7 +82,7 @@ pub fn tangents(
     let report = py.detach(|| {
         let mut uvs = uvs.to_vec();
         if flip_v {
-            bumpbake::format::stored::v_down(&mut uvs);
+            bumpbake::format::mesh::v_down(&mut uvs);
         }
         let mut attributes = vec![("POSITION".to_string(), Stream::from_f32("VEC3", positions))];
         if let Some(n) = normals {

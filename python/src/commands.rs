@@ -45,9 +45,9 @@ pub fn run(py: Python<'_>, argv: Vec<String>, progress: Option<Py<PyAny>>) -> Py
     crate::errors::speak_keywords();
     let (reporter, callback) = Callback::reporter(progress);
     let (result, out) = py.detach(|| {
-        cli::progress::report_to((!reporter.is_none()).then_some(reporter));
-        let r = cli::out::captured(|| cli::run(args));
-        cli::progress::report_to(None);
+        cli::progress_bars::report_to((!reporter.is_none()).then_some(reporter));
+        let r = cli::stdout::captured(|| cli::run(args));
+        cli::progress_bars::report_to(None);
         r
     });
     if let Some(e) = callback.and_then(|c| c.take_error()) {

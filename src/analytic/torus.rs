@@ -6,7 +6,7 @@
 //! tests share it.
 
 use crate::error::{Error, Result};
-use crate::scene::{ReadOptions, Scene};
+use crate::scene::ReadOptions;
 use glam::DVec3;
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -270,7 +270,7 @@ pub fn evaluate(
     truth: &(dyn Fn(DVec3, DVec3) -> Option<DVec3> + Sync),
     keep: &(dyn Fn(DVec3) -> bool + Sync),
 ) -> Result<Evaluation> {
-    let scene = Scene::read(out, &ReadOptions::default())?;
+    let scene = crate::format::read(out, &ReadOptions::default())?;
     let r = crate::scene::PrimRef { mesh: 0, primitive: 0 };
     let p = scene.primitive(r)?;
     let get = |n: &str| p.attr(n).ok_or_else(|| scene.err(format!("no {n}")));

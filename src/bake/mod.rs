@@ -41,8 +41,8 @@ pub struct BakeJob {
     pub read: ReadOptions,
     pub write: WriteOptions,
     pub depfile: Option<PathBuf>,
-    /// Ship the textures as KTX2 ([`crate::textures::ship`]); `None`: as made (PNG).
-    pub textures: Option<crate::textures::ShipOptions>,
+    /// Re-encode the normal textures as KTX2 ([`crate::textures::encode_ktx2`]); `None`: as made (PNG).
+    pub textures: Option<crate::textures::EncodeOptions>,
 }
 
 #[derive(Debug, Clone, serde::Serialize)]
@@ -84,9 +84,9 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
 
 /// [`run`] with HIGH meshes already in memory for a [`MapSource::Transfer`] job
 /// ([`crate::transfer::bake_from`]).
-pub fn run_from(job: &BakeJob, high: Vec<crate::format::raw::RawMesh>) -> Result<BakeReport> {
+pub fn run_from(job: &BakeJob, high: Vec<crate::transfer::high::HighMesh>) -> Result<BakeReport> {
     let mut t = Timings::default();
-    let mut scene = t.time("read", || Scene::read(&job.mesh, &job.read))?;
+    let mut scene = t.time("read", || crate::format::read(&job.mesh, &job.read))?;
     let mut deps = scene.dependencies();
     let created = scene.ensure_material();
     let mut warnings = Vec::new();
@@ -116,7 +116,7 @@ pub fn run_from(job: &BakeJob, high: Vec<crate::format::raw::RawMesh>) -> Result
     };
     let removed = if job.keep_all { Vec::new() } else { t.time("leave-out", || scene.leave_out(job.bitangents))? };
     let textures = match &job.textures {
-        Some(o) => Some(t.time("textures", || crate::textures::ship(&mut scene, o))?),
+        Some(o) => Some(t.time("textures", || crate::textures::encode_ktx2(&mut scene, o))?),
         None => None,
     };
     let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;

@@ -5,7 +5,7 @@ use bumpbake::batch::{self, BatchOptions};
 use bumpbake::format::image::ktx2::Codec;
 use bumpbake::normalmap::specular_aa::DEFAULT_THRESHOLD;
 use bumpbake::normalmap::{self as nm, Channel, Convention, Filter, Wrap};
-use bumpbake::textures::ShipOptions;
+use bumpbake::textures::EncodeOptions;
 use bumpbake::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -151,7 +151,7 @@ impl Ktx2Args {
 
 /// How glTF textures ship as KTX2 (`bake --textures ktx2`, `textures`).
 #[derive(clap::Args, Debug)]
-pub struct ShipArgs {
+pub struct TextureEncodeArgs {
     #[command(flatten)]
     pub ktx2: Ktx2Args,
     /// Keep each PNG/JPEG as the texture's source for clients without KTX2
@@ -170,13 +170,13 @@ pub struct ShipArgs {
     pub specular_aa_threshold: Option<f32>,
 }
 
-impl ShipArgs {
-    pub fn options(&self) -> Result<ShipOptions> {
+impl TextureEncodeArgs {
+    pub fn options(&self) -> Result<EncodeOptions> {
         let threshold = self.specular_aa_threshold.unwrap_or(DEFAULT_THRESHOLD);
         if !(0.0..=1.0).contains(&threshold) {
             return Err(Error::usage(format!("--specular-aa-threshold {threshold}: give a number from 0 to 1")));
         }
-        Ok(ShipOptions {
+        Ok(EncodeOptions {
             codec: self.ktx2.codec()?,
             fallback: self.ktx2_fallback,
             specular_aa: !self.no_specular_aa,
@@ -274,13 +274,15 @@ pub struct BatchArgs {
 impl BatchArgs {
     /// How to run `inputs`: a bar over the files when there are several and a person watches.
     pub fn options(&self, inputs: usize) -> BatchOptions {
-        let bar = inputs > 1 && super::progress::wanted(self.progress, self.quiet || self.json);
-        BatchOptions { jobs: self.jobs, progress: super::progress::reporter(bar) }
+        let bar = inputs > 1 && super::progress_bars::wanted(self.progress, self.quiet || self.json);
+        BatchOptions { jobs: self.jobs, progress: super::progress_bars::reporter(bar) }
     }
 
     /// Bars for one input's reads and bakes, when it is the only one and a person watches.
     pub fn single_progress(&self, inputs: usize) -> bumpbake::progress::Reporter {
-        super::progress::reporter(inputs == 1 && super::progress::wanted(self.progress, self.quiet || self.json))
+        super::progress_bars::reporter(
+            inputs == 1 && super::progress_bars::wanted(self.progress, self.quiet || self.json),
+        )
     }
 }
 

@@ -121,7 +121,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = TexturesArg::Png)]
     pub textures: TexturesArg,
     #[command(flatten)]
-    pub ship: super::args::ShipArgs,
+    pub encode: super::args::TextureEncodeArgs,
     #[command(flatten)]
     pub batch: super::args::BatchArgs,
 }
@@ -137,8 +137,8 @@ pub fn run(a: Args) -> Result<u8> {
         return Err(Error::usage("--strength must be finite"));
     }
     let transfer = transfer_settings(&a)?;
-    let textures = match (a.textures, a.ship.given()) {
-        (TexturesArg::Ktx2, _) => Some(a.ship.options()?),
+    let textures = match (a.textures, a.encode.given()) {
+        (TexturesArg::Ktx2, _) => Some(a.encode.options()?),
         (TexturesArg::Png, Some(flag)) => return Err(Error::usage(format!("{flag} needs --textures ktx2"))),
         (TexturesArg::Png, None) => None,
     };

@@ -22,7 +22,7 @@ pub fn completions(a: CompletionArgs) -> Result<u8> {
     let mut cmd = super::Cli::command();
     let mut script = Vec::new();
     clap_complete::generate(a.shell, &mut cmd, "bumpbake", &mut script);
-    super::out::write_all(&script)?;
+    super::stdout::write_all(&script)?;
     Ok(0)
 }
 
@@ -43,6 +43,6 @@ pub fn man(_a: ManArgs) -> Result<u8> {
         Ok(())
     };
     render(&mut out).map_err(|e| Error::output("stdout", e))?;
-    super::out::write_all(&out)?;
+    super::stdout::write_all(&out)?;
     Ok(0)
 }

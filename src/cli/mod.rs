@@ -1,7 +1,7 @@
 //! Command-line types (clap derive), one file per subcommand, each with its `run`.
 
 #[macro_use]
-pub mod out;
+pub mod stdout;
 
 mod args;
 mod bake;
@@ -12,7 +12,7 @@ mod normalmap;
 mod preview;
 mod print;
 pub mod process;
-pub mod progress;
+pub mod progress_bars;
 mod tangents;
 mod textures;
 mod validate;
@@ -61,6 +61,22 @@ impl Cli {
 
 /// Runs one parsed command line and returns the process exit code.
 pub fn run(cli: Cli) -> Result<u8> {
+    // `bench command` and `bench transfer` set this on the runs they measure and read the peak
+    // back from the `memtrace` lines (`bench::command::peak_of`).
+    let trace = std::env::var_os("BUMPBAKE_MEMTRACE").is_some();
+    if trace {
+        bumpbake::timings::trace_memory();
+    }
+    let code = run_command(cli);
+    if trace {
+        for m in bumpbake::timings::memory_marks() {
+            eprintln!("memtrace {}: rss {} kB peak {} kB", m.stage, m.rss_kib, m.peak_kib);
+        }
+    }
+    code
+}
+
+fn run_command(cli: Cli) -> Result<u8> {
     match cli.command {
         Command::Tangents(a) => tangents::run(a),
         Command::Normalmap(a) => normalmap::run(a),

@@ -1,14 +1,14 @@
 //! `bumpbake preview IN -o OUT.png` and `bumpbake preview --reference A --compare B -o diff.png`.
 
-use bumpbake::output::write_atomic;
-use bumpbake::preview::compare::{compare_with, Comparison, DiffKind};
-use bumpbake::preview::{render, Camera, CameraSpec, Light, Mips, Options, Params, Prepared, Resolve, Shading, View};
-use bumpbake::scene::{ReadOptions, Scene};
+use bumpbake::preview::compare::DiffKind;
+use bumpbake::preview::{
+    compare_files, render_file, CameraSpec, Comparing, Light, Mips, Options, Params, Resolve, Shading, View,
+};
+use bumpbake::scene::ReadOptions;
 use bumpbake::{Error, Result};
 use clap::builder::PossibleValue;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::LazyLock;
-use std::time::Instant;
 
 /// Render an asset with the reference bump-mapping model (shaders/) on the CPU, or measure pipeline error.
 #[derive(clap::Args, Debug)]
@@ -155,40 +155,6 @@ super::args::arg_enum! {
     }
 }
 
-/// One picture rendered (`--json`: `docs/json.md`, preview).
-#[derive(serde::Serialize)]
-pub struct Rendered {
-    pub input: PathBuf,
-    pub output: PathBuf,
-    pub view: &'static str,
-    pub width: u32,
-    pub height: u32,
-    pub ssaa: u32,
-    pub triangles: usize,
-    pub notes: Vec<String>,
-    pub time_ms: f64,
-    pub stages: Stages,
-}
-
-/// Where a preview's time went, in milliseconds.
-#[derive(serde::Serialize)]
-pub struct Stages {
-    pub read_ms: f64,
-    pub prepare_ms: f64,
-    pub render_ms: f64,
-    pub write_ms: f64,
-}
-
-/// `--compare`: the difference between two renders of the same view (`docs/preview.md`).
-#[derive(serde::Serialize)]
-pub struct Compared {
-    pub reference: PathBuf,
-    pub compare: PathBuf,
-    pub output: PathBuf,
-    pub time_ms: f64,
-    pub comparison: Comparison,
-}
-
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
     let p = |v: &str| {
@@ -199,10 +165,6 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
             .ok_or_else(|| format!("'{s}': sizes are 1 to 16384"))
     };
     Ok((p(w)?, p(h)?))
-}
-
-fn read(path: &Path, allow_outside: bool) -> Result<Scene> {
-    Scene::read(path, &ReadOptions { allow_outside, ..Default::default() })
 }
 
 pub fn run(a: Args) -> Result<u8> {
@@ -254,7 +216,7 @@ pub fn run(a: Args) -> Result<u8> {
     if a.compare.is_none() && (a.reference_mips.is_some() || a.reference_ssaa.is_some()) {
         return Err(Error::usage("preview: --reference-mips and --reference-ssaa need --compare"));
     }
-    let start = Instant::now();
+    let read = ReadOptions { allow_outside: a.allow_outside, ..Default::default() };
 
     if let Some(cand) = &a.compare {
         let reference = match (&a.reference, &a.input) {
@@ -268,17 +230,9 @@ pub fn run(a: Args) -> Result<u8> {
         if !matches!(a.view, ViewArg::Render(View::Shaded) | ViewArg::Diff) {
             return Err(Error::usage("preview: --compare writes the difference image; --view must be shaded or diff"));
         }
-        let r = read(reference, a.allow_outside)?;
-        let c = read(cand, a.allow_outside)?;
-        let (cmp, img) = compare_with(&r, &reference_opts, &c, &opts, a.diff.into())?;
-        write_atomic(&a.output, &img.to_png())?;
-        let done = Compared {
-            reference: reference.clone(),
-            compare: cand.clone(),
-            output: a.output.clone(),
-            time_ms: start.elapsed().as_secs_f64() * 1e3,
-            comparison: cmp,
-        };
+        let job =
+            Comparing { reference, reference_opts: &reference_opts, compare: cand, opts: &opts, diff: a.diff.into() };
+        let done = compare_files(&job, &a.output, &read)?;
         super::print::document(&done, a.json, a.quiet)?;
         return Ok(0);
     }
@@ -290,32 +244,7 @@ pub fn run(a: Args) -> Result<u8> {
         return Err(Error::usage("preview: --reference needs --compare"));
     }
     let input = a.input.as_ref().ok_or_else(|| Error::usage("preview: no input file"))?;
-    let scene = read(input, a.allow_outside)?;
-    let t_read = start.elapsed().as_secs_f64() * 1e3;
-    let prep = Prepared::with_frames(&scene, matches!(opts.view, View::Tangent | View::Bitangent | View::Handedness))?;
-    let t_prep = start.elapsed().as_secs_f64() * 1e3;
-    let cam = Camera::framed(prep.bounds, &opts.camera, opts.width, opts.height);
-    let frame = render(&prep, &cam, &opts);
-    let t_render = start.elapsed().as_secs_f64() * 1e3;
-    write_atomic(&a.output, &frame.to_png())?;
-    let ms = start.elapsed().as_secs_f64() * 1e3;
-    let done = Rendered {
-        input: input.clone(),
-        output: a.output.clone(),
-        view: opts.view.name(),
-        width: opts.width,
-        height: opts.height,
-        ssaa: opts.ssaa,
-        triangles: prep.triangle_count(),
-        notes: prep.notes,
-        time_ms: ms,
-        stages: Stages {
-            read_ms: t_read,
-            prepare_ms: t_prep - t_read,
-            render_ms: t_render - t_prep,
-            write_ms: ms - t_render,
-        },
-    };
+    let done = render_file(input, &a.output, &opts, &read)?;
     super::print::document(&done, a.json, a.quiet)?;
     Ok(0)
 }

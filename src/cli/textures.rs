@@ -14,7 +14,7 @@ pub struct Args {
     #[command(flatten)]
     pub io: super::args::MeshIo,
     #[command(flatten)]
-    pub ship: super::args::ShipArgs,
+    pub encode: super::args::TextureEncodeArgs,
     /// Images inside the output (GLB, or .gltf's buffer) or as files beside a .gltf.
     #[arg(long, value_parser = ["embed", "external"], default_value = "embed")]
     pub images: String,
@@ -24,7 +24,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<u8> {
     let outputs = a.io.outputs(&a.batch.out_dir)?;
-    let options = a.ship.options()?;
+    let options = a.encode.options()?;
     let job = |input: &Path, output: &Path| TexturesJob {
         input: input.to_path_buf(),
         output: output.to_path_buf(),

@@ -128,7 +128,7 @@ impl Prepared {
     /// [`Prepared::new`], and `all_frames` also generates MikkTSpace tangents for primitives
     /// whose material has no normal map (for the tangent, bitangent and handedness views).
     pub fn with_frames(scene: &Scene, all_frames: bool) -> Result<Prepared> {
-        let mut cx = Cx {
+        let mut gatherer = Gatherer {
             scene,
             mats: scene.materials().clone(),
             all_frames,
@@ -137,7 +137,7 @@ impl Prepared {
             material_index: HashMap::new(),
             notes: Vec::new(),
         };
-        let views = views(scene, &cx.mats);
+        let views = views(scene, &gatherer.mats);
         let mut of_mesh: HashMap<usize, Vec<&PrimView>> = HashMap::new();
         views.iter().for_each(|v| of_mesh.entry(v.at.mesh).or_default().push(v));
         let mut draws = Vec::new();
@@ -146,11 +146,11 @@ impl Prepared {
             for &view in of_mesh.get(&inst.mesh).into_iter().flatten() {
                 let r = view.at;
                 if let std::collections::hash_map::Entry::Vacant(e) = prim_cache.entry(r) {
-                    let local = cx.local(view)?;
+                    let local = gatherer.local(view)?;
                     e.insert(local);
                 }
                 if let Some(Some(local)) = prim_cache.get(&r) {
-                    let material = cx.material(r)?;
+                    let material = gatherer.material(r)?;
                     draws.push(place(local, &inst, material, r));
                 }
             }
@@ -171,7 +171,7 @@ impl Prepared {
         if !(lo.is_finite() && hi.is_finite()) {
             return Err(scene.err("nothing to draw: the scene shows no triangles"));
         }
-        Ok(Prepared { draws, materials: cx.materials, bounds: (lo, hi), notes: cx.notes })
+        Ok(Prepared { draws, materials: gatherer.materials, bounds: (lo, hi), notes: gatherer.notes })
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -189,7 +189,9 @@ struct Local {
     triangles: Vec<[u32; 3]>,
 }
 
-struct Cx<'a> {
+/// What gathering a scene keeps as it goes: each texture and material decoded once, and the notes
+/// on what was not drawn.
+struct Gatherer<'a> {
     scene: &'a Scene,
     mats: Materials,
     all_frames: bool,
@@ -199,7 +201,7 @@ struct Cx<'a> {
     notes: Vec<String>,
 }
 
-impl Cx<'_> {
+impl Gatherer<'_> {
     fn local(&mut self, view: &PrimView) -> Result<Option<Local>> {
         let s = self.scene;
         let r = view.at;
@@ -322,7 +324,7 @@ impl Cx<'_> {
         if !s.has_texture(ti) {
             return Err(s.err(format!("texture {ti} does not exist")));
         }
-        let choice = s.texture_image_to_decode(ti)?;
+        let choice = crate::format::image::texture_image_to_decode(s, ti)?;
         self.notes.extend(choice.note(ti));
         let Some((chosen, bytes)) = choice.chosen else {
             if choice.passed_over.is_empty() {

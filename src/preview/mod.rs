@@ -15,9 +15,12 @@
 //! - [`pbr`]: glTF's metallic-roughness BRDF (`Shading::Pbr`).
 //! - [`views`]: the debug views.
 //! - [`compare`]: pipeline error between two renders.
+//! - [`file`]: the `preview` command file to file ([`render_file`], [`compare_files`]) and its
+//!   reports.
 
 pub mod camera;
 pub mod compare;
+pub mod file;
 pub mod gather;
 pub mod lod;
 pub mod pbr;
@@ -27,6 +30,7 @@ pub mod texture;
 pub mod views;
 
 pub use camera::{Camera, CameraSpec};
+pub use file::{compare_files, render_file, Compared, Comparing, Rendered, Stages};
 pub use gather::Prepared;
 pub use shade::{Light, Params, Shading};
 pub use texture::Mips;

@@ -1,4 +1,4 @@
-//! What shipping textures as KTX2 changes in the document (`textures::ship`): a texture's
+//! What shipping textures as KTX2 changes in the document (`textures::encode_ktx2`): a texture's
 //! `KHR_texture_basisu` source, the extension's place in `extensionsUsed`/`extensionsRequired`, a
 //! material's metallic-roughness texture and factors, and the textures and images that fall out
 //! of use. Material and texture JSON is changed here, in the model, so the stage never names a key.

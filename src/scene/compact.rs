@@ -188,7 +188,8 @@ mod tests {
             "materials": [{ "normalTexture": { "index": 0 } }],
             "textures": [{ "source": 0 }],
         });
-        Scene::read_bytes(Path::new("t.gltf"), &serde_json::to_vec(&json).unwrap(), &ReadOptions::default()).unwrap()
+        crate::format::read_bytes(Path::new("t.gltf"), &serde_json::to_vec(&json).unwrap(), &ReadOptions::default())
+            .unwrap()
     }
 
     const P: PrimRef = PrimRef { mesh: 0, primitive: 0 };

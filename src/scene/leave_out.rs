@@ -242,7 +242,7 @@ fn quoted(name: Option<&str>) -> String {
 
 #[cfg(test)]
 mod tests {
-    use crate::scene::{ReadOptions, Scene, Slot};
+    use crate::scene::{ReadOptions, Slot};
     use serde_json::json;
     use std::path::Path;
 
@@ -263,8 +263,9 @@ mod tests {
             "meshes": [{ "primitives": [{ "attributes": { "TEXCOORD_0": 0, "TEXCOORD_1": 0 }, "material": 1 }] }],
             "accessors": [{ "count": 0, "componentType": 5126, "type": "VEC2" }],
         });
-        let mut s = Scene::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&doc).unwrap(), &ReadOptions::default())
-            .unwrap();
+        let mut s =
+            crate::format::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&doc).unwrap(), &ReadOptions::default())
+                .unwrap();
         let before = s.materials() as *const _;
         assert_eq!(s.materials() as *const _, before, "read once");
         assert_eq!(s.materials().list[1].texture(Slot::Normal).unwrap().tex_coord, 1);
@@ -301,8 +302,9 @@ mod tests {
             "meshes": [{ "primitives": [{ "attributes": { "TEXCOORD_0": 0 }, "material": 0 }] }],
             "accessors": [{ "count": 0, "componentType": 5126, "type": "VEC2" }],
         });
-        let mut s = Scene::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&doc).unwrap(), &ReadOptions::default())
-            .unwrap();
+        let mut s =
+            crate::format::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&doc).unwrap(), &ReadOptions::default())
+                .unwrap();
         let removed = s.leave_out(false).unwrap();
         let images: Vec<_> = removed.iter().filter(|r| r.what.starts_with("image ")).collect();
         assert_eq!(images.len(), 1, "{removed:?}");

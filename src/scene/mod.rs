@@ -17,6 +17,7 @@ pub mod normals;
 pub mod refs;
 pub mod shape;
 pub mod texcoord;
+pub mod texture_images;
 pub mod uv_transform;
 pub mod view;
 pub mod weld;

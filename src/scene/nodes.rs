@@ -1,7 +1,7 @@
 //! The node tree, walked one way for every stage: which meshes a scene shows and where.
 
 use super::Scene;
-use glam::{Mat3, Mat4, Quat, Vec3};
+use glam::{DVec3, Mat3, Mat4, Quat, Vec3};
 use serde_json::Value;
 
 /// One place a mesh is shown.
@@ -86,6 +86,12 @@ pub struct Placement {
 impl Placement {
     pub fn point(&self, p: Vec3) -> Vec3 {
         self.world.transform_point3(p)
+    }
+
+    /// [`Self::point`] in f64, for a caller that moves points far from the origin into a frame
+    /// of its own before they become f32 (the baker).
+    pub fn point_f64(&self, p: DVec3) -> DVec3 {
+        self.world.as_dmat4().transform_point3(p)
     }
 
     /// A normal's direction in the world (by [`Instance::normal_matrix`]).

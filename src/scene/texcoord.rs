@@ -181,7 +181,7 @@ mod tests {
         let mut m = json!({ "normalTexture": { "index": 0, "texCoord": 1 }, "occlusionTexture": { "index": 1, "texCoord": 1, "extensions": { "KHR_texture_transform": { "texCoord": 1 } } } });
         let mut doc = json!({ "asset": { "version": "2.0" }, "materials": [m] });
         crate::scene::shape::pad_references(&mut doc);
-        let scene = crate::scene::Scene::read_bytes(
+        let scene = crate::format::read_bytes(
             std::path::Path::new("m.gltf"),
             &serde_json::to_vec(&doc).unwrap(),
             &crate::scene::ReadOptions::default(),

@@ -240,7 +240,8 @@ mod tests {
 
     fn scene(mut j: Value) -> Scene {
         crate::scene::shape::pad_references(&mut j);
-        Scene::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&j).unwrap(), &ReadOptions::default()).unwrap()
+        crate::format::read_bytes(Path::new("m.gltf"), &serde_json::to_vec(&j).unwrap(), &ReadOptions::default())
+            .unwrap()
     }
 
     #[test]

@@ -3,7 +3,7 @@
 use super::apply::{apply, ApplyOptions, PrimTangents};
 use crate::error::Result;
 use crate::format::{self, WriteOptions, WriteStats};
-use crate::scene::{ReadOptions, Scene};
+use crate::scene::ReadOptions;
 use crate::timings::Timings;
 use std::path::{Path, PathBuf};
 
@@ -38,7 +38,7 @@ pub struct TangentsReport {
 /// Runs the job. Nothing is written unless every step succeeds.
 pub fn run(job: &TangentsJob) -> Result<TangentsReport> {
     let mut t = Timings::default();
-    let mut scene = t.time("read", || Scene::read(&job.input, &job.read))?;
+    let mut scene = t.time("read", || crate::format::read(&job.input, &job.read))?;
     crate::timings::mem_mark("read");
     let prims = t.time("tangents", || apply(&mut scene, &job.apply))?;
     crate::timings::mem_mark("tangents");

@@ -3,7 +3,7 @@
 //! a metallic-roughness texture whose roughness levels carry what the normal levels lost
 //! ([`crate::normalmap::specular_aa`]). Every other texture is left as it was.
 //!
-//! `bake --textures ktx2` runs [`ship`] on its scene before writing; `bumpbake textures` runs
+//! `bake --textures ktx2` runs [`encode_ktx2`] on its scene before writing; `bumpbake textures` runs
 //! [`run`] on files other tools wrote.
 
 pub mod roughness;
@@ -23,9 +23,9 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-/// How [`ship`] encodes.
+/// How [`encode_ktx2`] encodes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ShipOptions {
+pub struct EncodeOptions {
     /// The normal maps' codec.
     pub codec: Codec,
     /// Keep the PNG/JPEG as each texture's core `source`, for clients without KTX2: the
@@ -37,9 +37,9 @@ pub struct ShipOptions {
     pub threshold: f32,
 }
 
-impl Default for ShipOptions {
+impl Default for EncodeOptions {
     fn default() -> Self {
-        ShipOptions {
+        EncodeOptions {
             codec: Codec::Uastc { level: DEFAULT_UASTC_LEVEL, rdo: None },
             fallback: false,
             specular_aa: true,
@@ -74,7 +74,7 @@ pub struct MaterialTextures {
     pub roughness: Option<RoughnessReport>,
 }
 
-/// What [`ship`] did.
+/// What [`encode_ktx2`] did.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct TexturesReport {
     /// `uastc level N` or `etc1s quality N`.
@@ -149,7 +149,7 @@ fn encode_normal(scene: &mut Scene, image: usize, bytes: &[u8], codec: Codec) ->
 
 /// Re-encodes every material's normal texture as KTX2 and, with `opts.specular_aa`, gives it a
 /// widened metallic-roughness texture. Textures and images only these used are dropped.
-pub fn ship(scene: &mut Scene, opts: &ShipOptions) -> Result<TexturesReport> {
+pub fn encode_ktx2(scene: &mut Scene, opts: &EncodeOptions) -> Result<TexturesReport> {
     let mut report = TexturesReport {
         codec: codec_words(opts.codec),
         fallback: opts.fallback,
@@ -255,7 +255,7 @@ fn core_fallback(scene: &Scene, n: &TextureUse) -> bool {
 pub struct TexturesJob {
     pub input: PathBuf,
     pub output: PathBuf,
-    pub options: ShipOptions,
+    pub options: EncodeOptions,
     pub read: ReadOptions,
     pub write: WriteOptions,
     pub depfile: Option<PathBuf>,
@@ -274,9 +274,9 @@ pub struct TexturesRun {
 
 pub fn run(job: &TexturesJob) -> Result<TexturesRun> {
     let mut t = Timings::default();
-    let mut scene = t.time("read", || Scene::read(&job.input, &job.read))?;
+    let mut scene = t.time("read", || crate::format::read(&job.input, &job.read))?;
     let deps = scene.dependencies();
-    let textures = t.time("textures", || ship(&mut scene, &job.options))?;
+    let textures = t.time("textures", || encode_ktx2(&mut scene, &job.options))?;
     let (mut files, written) = t.time("encode", || format::write(&scene, &job.output, &job.write))?;
     if let Some(d) = &job.depfile {
         files.add(d, crate::output::depfile(&[&job.output], &deps));

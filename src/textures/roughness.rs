@@ -7,7 +7,7 @@
 //! map's texel centres; it must be read through the same UV set and transform as the normal
 //! texture, or its texels do not correspond and the material is left as it was.
 
-use super::{decodable, decode, encode_levels, ktx2_of, RoughnessReport, ShipOptions};
+use super::{decodable, decode, encode_levels, ktx2_of, EncodeOptions, RoughnessReport};
 use crate::error::{Error, Result};
 use crate::format::image::ktx2::Codec;
 use crate::normalmap::mips::{self, MipLevel};
@@ -145,7 +145,7 @@ pub(super) fn widen_material(
     m: usize,
     n: &TextureUse,
     normal: &[MipLevel],
-    opts: &ShipOptions,
+    opts: &EncodeOptions,
 ) -> Result<std::result::Result<Widened, String>> {
     if scene.is_specular_glossiness(m) {
         return Ok(Err(

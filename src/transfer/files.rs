@@ -1,7 +1,8 @@
 //! The files a bake writes besides OUT: the map itself (PNG, TIFF or EXR), the height map and the
 //! miss mask, one set per material, named after it when there are several.
 
-use super::{Settings, Texel};
+use super::tracer::Texel;
+use super::Settings;
 use crate::error::{Error, Result};
 use crate::normalmap::{self, Convention, Depth, NormalData, NormalImage, PngSettings};
 use crate::scene::Scene;

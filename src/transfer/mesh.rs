@@ -8,9 +8,9 @@
 //! through the node's matrix (as three.js, Babylon.js and the glTF sample viewer do), each
 //! normalised per vertex, and `w` negated on a mirroring node.
 
+use super::high::{part_range, read_high, HighMesh};
 use crate::error::{Error, Result, Setting, Words};
-use crate::format::raw::{part_range, read_raw, RawMesh};
-use crate::scene::nodes::{instances, Instance};
+use crate::scene::nodes::{instances, Instance, Placement};
 use crate::scene::to_triangle_list;
 use crate::scene::{smooth_vertex_normals, PrimRef, PrimView, ReadOptions, Scene};
 use glam::{DVec3, Mat4, Vec3, Vec3A};
@@ -52,10 +52,10 @@ impl High {
     /// Appends a mesh as read, moving its positions into the frame centred on `origin`; smooth
     /// normals where it has none, per part (each part's primitive has its own vertices). Its
     /// arrays are taken over, not copied, when HIGH is empty.
-    fn append(&mut self, raw: RawMesh, origin: DVec3) {
+    fn append(&mut self, raw: HighMesh, origin: DVec3) {
         let (mut normal_triangles, mut normals) = (raw.normal_triangles, raw.normals);
         let (mut positions, triangles) = (raw.positions, raw.triangles);
-        // RawMesh normals are unit already; only a HIGH without any gets smooth ones, per part.
+        // HighMesh normals are unit already; only a HIGH without any gets smooth ones, per part.
         if normals.is_empty() {
             normal_triangles = Vec::with_capacity(triangles.len());
             for k in 0..raw.parts.len().max(1) {
@@ -104,8 +104,8 @@ pub struct HighPart {
 #[derive(Debug, Clone)]
 pub struct Placed {
     pub prim: PrimRef,
-    /// `None` at identity (kept bit for bit).
-    pub world: Option<Mat4>,
+    /// How the node places it; `None` at identity (kept bit for bit).
+    pub placement: Option<Placement>,
     /// The part: the node's name, else the mesh's.
     pub part: String,
 }
@@ -162,14 +162,10 @@ pub fn place(scene: &Scene, prims: &[PrimRef], node: Option<&str>) -> Result<Vec
                 }
             }
         };
-        let part = inst
-            .and_then(|i| i.node)
-            .and_then(|n| scene.array("nodes").get(n))
-            .and_then(|n| n.get("name"))
-            .and_then(|s| s.as_str());
+        let part = inst.and_then(|i| i.node).and_then(|n| scene.node_name(n));
         out.push(Placed {
             prim: r,
-            world: inst.map(|i| i.world).filter(|w| *w != Mat4::IDENTITY),
+            placement: inst.filter(|i| i.world != Mat4::IDENTITY).map(|i| i.placement()),
             part: part.map_or_else(|| mesh_name(scene, r.mesh), str::to_string),
         });
     }
@@ -194,12 +190,9 @@ pub fn low_parts(placed: &[Placed]) -> (Vec<String>, Vec<u32>) {
 
 fn world_positions(scene: &Scene, p: &Placed) -> Result<Vec<DVec3>> {
     let pos = scene.primitive(p.prim)?.positions();
-    Ok(match p.world {
+    Ok(match &p.placement {
         None => pos.into_iter().map(dvec).collect(),
-        Some(m) => {
-            let m = m.as_dmat4();
-            pos.into_iter().map(|q| m.transform_point3(dvec(q))).collect()
-        }
+        Some(place) => pos.into_iter().map(|q| place.point_f64(dvec(q))).collect(),
     })
 }
 
@@ -244,13 +237,12 @@ pub fn low(scene: &Scene, placed: &[Placed], part: &[u32], origin: DVec3, diagon
         out.positions.extend(world_positions(scene, pl)?.into_iter().map(|q| local(q, origin)));
         let normals = g.normals().unwrap_or_default();
         let tangents: Vec<[f32; 4]> = g.tangents().unwrap_or_default();
-        match pl.world {
+        match &pl.placement {
             None => {
                 out.normals.extend(normals.iter().map(|&n| Vec3A::from(n)));
                 out.tangents.extend(tangents);
             }
-            Some(m) => {
-                let place = Instance { mesh: r.mesh, node: None, world: m }.placement();
+            Some(place) => {
                 out.normals
                     .extend(normals.iter().map(|&n| Vec3A::from(place.normal(Vec3::from(n))).normalize_or_zero()));
                 out.tangents.extend(tangents.into_iter().map(|t| {
@@ -274,7 +266,7 @@ pub fn high(
     paths: &[std::path::PathBuf],
     read: &ReadOptions,
     origin: DVec3,
-    given: Vec<RawMesh>,
+    given: Vec<HighMesh>,
 ) -> Result<(High, Vec<usize>, Vec<HighPart>)> {
     let mut h = High::default();
     let mut counts = Vec::new();
@@ -283,7 +275,7 @@ pub fn high(
     for (f, path) in paths.iter().enumerate() {
         let raw = match given.next() {
             Some(m) => m,
-            None => read_raw(path, read)?,
+            None => read_high(path, read)?,
         };
         if raw.triangles.is_empty() {
             return Err(Error::input(path, "has no triangles to bake from (HIGH must be a triangle mesh)"));
@@ -313,7 +305,7 @@ pub fn cage(
     placed: &[Placed],
     low: &Low,
 ) -> Result<Vec<[Vec3A; 3]>> {
-    let scene = Scene::read(path, read)?;
+    let scene = crate::format::read(path, read)?;
     let prims: Vec<PrimRef> =
         scene.primitives().into_iter().filter(|&r| crate::scene::view::is_surface(&scene, r)).collect();
     let same = placed.iter().all(|p| prims.contains(&p.prim));

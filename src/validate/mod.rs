@@ -286,11 +286,11 @@ pub fn validate_many(paths: &[PathBuf], opts: &Options, jobs: usize) -> Result<(
 pub fn validate_path(path: &Path, opts: &Options) -> Result<FileReport> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read: {e}")))?;
-    // GLB is known by its magic whatever the name, as `Scene::read` does.
+    // GLB is known by its magic whatever the name, as `format::read` does.
     let mesh = matches!(ext.as_str(), "gltf" | "glb" | "obj") || bytes.starts_with(b"glTF");
     let mut rep = if mesh {
         drop(bytes);
-        let scene = Scene::read(path, &opts.read)?;
+        let scene = crate::format::read(path, &opts.read)?;
         FileReport { path: path.to_path_buf(), kind: "mesh", subjects: validate_scene(&scene, opts)? }
     } else {
         use crate::format::image::{self as img, Kind};

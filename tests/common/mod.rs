@@ -67,7 +67,7 @@ fn fresh(d: PathBuf) -> PathBuf {
 }
 
 pub fn load(path: &Path) -> Scene {
-    Scene::read(path, &ReadOptions::default()).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
+    bumpbake::format::read(path, &ReadOptions::default()).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
 }
 
 pub fn s(p: &Path) -> &str {

@@ -146,7 +146,7 @@ pub fn engine_name(e: Engine) -> &'static str {
 /// A mesh file as a case: every triangle primitive with UVs (set 0) in one mesh; primitives without
 /// normals get the smooth normals an OBJ without them gets. It has no exact tangent.
 fn case_from_file(path: &std::path::Path) -> Result<Case> {
-    let scene = bumpbake::scene::Scene::read(path, &Default::default())?;
+    let scene = bumpbake::format::read(path, &Default::default())?;
     let label = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let mut c = Case {
         surface: Surface::Mesh,

@@ -44,7 +44,7 @@ pub struct BenchTransferArgs {
     /// files too, interleaved with bumpbake's runs, and the row gives the ratio.
     #[arg(long, value_name = "PYTHON")]
     pub blender: Option<std::path::PathBuf>,
-    /// Also time the reader alone (`read_raw`, in this process) this many times on each large
+    /// Also time the reader alone (`read_high`, in this process) this many times on each large
     /// row's OBJ or PLY file, for its MB/s.
     #[arg(long, default_value_t = 3)]
     pub large_read: usize,

@@ -3,10 +3,10 @@
 //! `validate`'s text is in `validate.rs`, beside its other formats.
 
 use super::Human;
-use crate::cli::preview::{Compared, Rendered};
 use bumpbake::bake::BakeReport;
 use bumpbake::inspect::Inspection;
 use bumpbake::normalmap::Converted;
+use bumpbake::preview::{Compared, Rendered};
 use bumpbake::scene::Slot;
 use bumpbake::tangent::command::TangentsReport;
 use bumpbake::textures::{TexturesReport, TexturesRun};

@@ -20,6 +20,7 @@
 pub mod ktx2;
 
 use crate::error::{Fault, Faulty, Setting, Words};
+use crate::scene::texture_images::TextureImage;
 use image::{DynamicImage, ImageDecoder, ImageError, ImageFormat, ImageReader};
 use std::io::Cursor;
 
@@ -371,53 +372,26 @@ pub fn file_is_png(path: &std::path::Path) -> bool {
     std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut head)).is_ok() && Kind::sniff(&head) == Kind::Png
 }
 
-/// A glTF image a texture may show, and the extension that names it (`None`: the texture's
-/// core `source`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TextureImage {
-    pub image: usize,
-    pub extension: Option<&'static str>,
+/// The image of `texture` to decode, with its bytes: the first of
+/// [`Scene::texture_images`](crate::scene::Scene::texture_images) not in a format bumpbake
+/// knows and does not decode. Also returns the images passed over, with
+/// their formats and why, so that callers can say what was not read.
+pub fn texture_image_to_decode(scene: &crate::scene::Scene, texture: usize) -> crate::error::Result<TextureChoice> {
+    let mut choice = TextureChoice::default();
+    for ti in scene.texture_images(texture) {
+        let bytes = scene.image_bytes(ti.image)?;
+        // Bytes in no format at all are a broken image, for the decoder to refuse: only
+        // formats (and KTX2 variants) known and not decoded are passed over.
+        match not_decoded_why(&bytes) {
+            None if choice.chosen.is_none() => choice.chosen = Some((ti, bytes)),
+            None => {}
+            Some(why) => choice.passed_over.push((ti, Kind::sniff(&bytes), why)),
+        }
+    }
+    Ok(choice)
 }
 
-impl crate::scene::Scene {
-    /// Every image texture `texture` can show: the extensions' sources first (a client that
-    /// supports one shows it), then the core `source` (the fallback). Each image once.
-    pub fn texture_images(&self, texture: usize) -> Vec<TextureImage> {
-        let Some(t) = self.json.pointer(&format!("/textures/{texture}")) else { return Vec::new() };
-        let mut out: Vec<TextureImage> = Vec::new();
-        let from_ext = crate::scene::refs::IMAGE_SOURCE_EXTENSIONS.iter().filter_map(|&ext| {
-            let i = t.pointer(&format!("/extensions/{ext}/source")).and_then(crate::scene::as_index)?;
-            Some(TextureImage { image: i, extension: Some(ext) })
-        });
-        let core = t.get("source").and_then(crate::scene::as_index).map(|i| TextureImage { image: i, extension: None });
-        for ti in from_ext.chain(core) {
-            if !out.iter().any(|o| o.image == ti.image) {
-                out.push(ti);
-            }
-        }
-        out
-    }
-
-    /// The image of `texture` to decode, with its bytes: the first of [`Self::texture_images`]
-    /// not in a format bumpbake knows and does not decode. Also returns the images passed over, with
-    /// their formats and why, so that callers can say what was not read.
-    pub fn texture_image_to_decode(&self, texture: usize) -> crate::error::Result<TextureChoice> {
-        let mut choice = TextureChoice::default();
-        for ti in self.texture_images(texture) {
-            let bytes = self.image_bytes(ti.image)?;
-            // Bytes in no format at all are a broken image, for the decoder to refuse: only
-            // formats (and KTX2 variants) known and not decoded are passed over.
-            match not_decoded_why(&bytes) {
-                None if choice.chosen.is_none() => choice.chosen = Some((ti, bytes)),
-                None => {}
-                Some(why) => choice.passed_over.push((ti, Kind::sniff(&bytes), why)),
-            }
-        }
-        Ok(choice)
-    }
-}
-
-/// What [`crate::scene::Scene::texture_image_to_decode`] found.
+/// What [`texture_image_to_decode`] found.
 #[derive(Debug, Default)]
 pub struct TextureChoice {
     /// The image to decode and its encoded bytes.

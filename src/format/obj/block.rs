@@ -12,7 +12,7 @@
 
 use super::piece::{count, Counts, Forward, Piece};
 use crate::error::{Error, Result};
-use crate::format::stored::{StoredMesh, MISSING};
+use crate::format::mesh::{StoredMesh, MISSING};
 use crate::progress::Reporter;
 use memchr::memchr;
 use rayon::prelude::*;

@@ -2,8 +2,8 @@
 //! numbers and faces of positive indices, read straight from the bytes with no token scanned
 //! twice. Whatever else such a line holds sends it back to the general path in `piece.rs`.
 
-use crate::format::number::{digits8, lead_f32};
-use crate::format::stored::MISSING;
+use crate::format::mesh::text_number::{digits8, lead_f32};
+use crate::format::mesh::MISSING;
 
 /// A face corner's `v`, `vt` and `vn` indices, 0-based ([`MISSING`] where it names none).
 pub(super) type Corner = [u32; 3];

@@ -13,8 +13,8 @@ mod mtl;
 pub mod parse;
 mod piece;
 
-use super::build::{build_primitive, empty_scene, set_nodes, Model};
-use super::stored::{runs, StoredMesh, MISSING};
+use super::mesh::to_gltf::{build_primitive, empty_scene, set_nodes, Model};
+use super::mesh::{runs, StoredMesh, MISSING};
 use crate::error::{Error, Result};
 use crate::scene::{array_mut, set_key, PrimRef, ReadOptions, Scene, SourceFormat};
 use mtl::{add_material, load_materials};

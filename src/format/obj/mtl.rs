@@ -17,7 +17,7 @@ pub(super) fn load_materials(path: &Path, base_dir: &Path, libs: &[String], opts
     let (mut materials, mut map, mut files, mut failed) = (Vec::new(), HashMap::new(), Vec::new(), None);
     for name in libs {
         files.push(base_dir.join(name));
-        let bytes = crate::format::uri::read(name, base_dir, path, opts.allow_outside)?;
+        let bytes = crate::format::gltf::uri::read(name, base_dir, path, opts.allow_outside)?;
         match tobj::load_mtl_buf(&mut BufReader::new(bytes.as_slice())) {
             Ok((mut mats, names)) => {
                 let offset = materials.len();
@@ -144,7 +144,7 @@ pub(super) fn add_material(scene: &mut Scene, index: usize, m: &tobj::Material) 
 /// more pixels than [`crate::format::image::Limits::TEXTURE`] allows, checked from the header before anything is
 /// allocated) count as heights, with a note saying why; `bake` reports them when it needs them.
 fn looks_like_normal_map(scene: &mut Scene, file: &str) -> bool {
-    let bytes = match crate::format::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) {
+    let bytes = match crate::format::gltf::uri::read(file, &scene.base_dir, &scene.source, scene.allow_outside) {
         Ok(b) => b,
         Err(e) => {
             scene

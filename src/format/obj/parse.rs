@@ -11,7 +11,7 @@
 
 use super::block::Acc;
 use crate::error::{Error, Result};
-use crate::format::stored::StoredMesh;
+use crate::format::mesh::StoredMesh;
 use crate::progress::{Counting, Reporter};
 use memchr::memrchr;
 use std::io::Read;

@@ -1,6 +1,6 @@
 use super::*;
-use crate::format::number::{lead_f32, parse_f32};
-use crate::format::stored::{Statement, MISSING};
+use crate::format::mesh::text_number::{lead_f32, parse_f32};
+use crate::format::mesh::{Statement, MISSING};
 
 fn parse(s: &str) -> StoredMesh {
     parse_bytes(Path::new("t.obj"), s.as_bytes(), &Default::default()).unwrap()

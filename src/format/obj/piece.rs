@@ -2,8 +2,8 @@
 //! the line reader, with the common lines' own path (`fast.rs`) tried first.
 
 use super::fast::{fast_corners, fast_floats, Corner};
-use crate::format::number::{is_space, parse_f32, short_int};
-use crate::format::stored::{Statement, MISSING};
+use crate::format::mesh::text_number::{is_space, parse_f32, short_int};
+use crate::format::mesh::{Statement, MISSING};
 use memchr::memchr;
 
 /// How many `v`, `vt`, `vn` and lines a piece holds (or come before it).

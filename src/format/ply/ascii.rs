@@ -8,7 +8,7 @@
 //! it give up, and the sequential reader reads the element again and names the first bad record.
 
 use super::{fan, Element};
-use crate::format::number::{parse_f32, short_int};
+use crate::format::mesh::text_number::{parse_f32, short_int};
 use memchr::{memchr, memchr_iter};
 use rayon::prelude::*;
 

@@ -18,8 +18,8 @@ mod scene;
 
 pub use scene::scene;
 
-use super::number::parse_f32;
-use super::stored::{check_finite, StoredMesh};
+use super::mesh::text_number::parse_f32;
+use super::mesh::{check_finite, StoredMesh};
 use crate::error::{Error, Result};
 use std::path::Path;
 

@@ -1,8 +1,8 @@
-//! A PLY mesh as a [`Scene`]: the PLY side of `Scene::read`, beside the reader.
+//! A PLY mesh as a [`Scene`]: the PLY side of `format::read`, beside the reader.
 
 use crate::error::{Error, Result};
-use crate::format::build::{build_primitive, empty_scene, set_nodes, Model};
-use crate::format::stored::StoredMesh;
+use crate::format::mesh::to_gltf::{build_primitive, empty_scene, set_nodes, Model};
+use crate::format::mesh::StoredMesh;
 use crate::scene::{set_key, PrimRef, ReadOptions, Scene, SourceFormat};
 use serde_json::json;
 use std::path::Path;

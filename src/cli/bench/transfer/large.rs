@@ -6,7 +6,7 @@
 use super::row::time_one;
 use bumpbake::analytic::torus::{evaluate, Evaluation, Torus};
 use bumpbake::error::{Error, Result};
-use bumpbake::format::raw::RawMesh;
+use bumpbake::transfer::high::HighMesh;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::TAU;
@@ -69,11 +69,11 @@ pub struct LargeRow {
     /// Blender's bake of the same files, interleaved (`--blender`, file rows only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blender: Option<super::blender::BlenderRow>,
-    /// The reader alone (`format::raw::read_raw` in the bench's process), for file rows.
+    /// The reader alone (`transfer::high::read_high` in the bench's process), for file rows.
     pub reader: Option<ReadTiming>,
 }
 
-/// `read_raw` on a large row's file, timed in the bench's process (the file in the page cache).
+/// `read_high` on a large row's file, timed in the bench's process (the file in the page cache).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ReadTiming {
     pub runs: usize,
@@ -93,7 +93,7 @@ pub fn tessellation(millions: f64) -> (usize, usize) {
 }
 
 /// HIGH as [`Torus::high`] makes it, straight into the baker's form, built in parallel.
-fn high_raw(torus: &Torus, n_th: usize, n_ph: usize) -> RawMesh {
+fn high_raw(torus: &Torus, n_th: usize, n_ph: usize) -> HighMesh {
     let vn: Vec<([f32; 3], [f32; 3])> = (0..n_th * n_ph)
         .into_par_iter()
         .map(|k| {
@@ -112,12 +112,12 @@ fn high_raw(torus: &Torus, n_th: usize, n_ph: usize) -> RawMesh {
             [[a, b, c], [a, c, d]]
         })
         .collect();
-    let parts = vec![bumpbake::format::raw::Part { name: "torus".into(), material: None, start: 0 }];
-    RawMesh { positions, normals, normal_triangles: triangles.clone(), triangles, parts, ..Default::default() }
+    let parts = vec![bumpbake::transfer::high::Part { name: "torus".into(), material: None, start: 0 }];
+    HighMesh { positions, normals, normal_triangles: triangles.clone(), triangles, parts, ..Default::default() }
 }
 
 /// Writes `m` as OBJ (`v`, `vn`, `f a//a b//b c//c`), formatted in parallel blocks.
-pub fn write_obj(m: &RawMesh, path: &Path) -> Result<()> {
+pub fn write_obj(m: &HighMesh, path: &Path) -> Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| Error::output(path, e))?);
     let io = |e| Error::output(path, e);
     const BLOCK: usize = 1 << 16;
@@ -156,7 +156,7 @@ pub fn write_obj(m: &RawMesh, path: &Path) -> Result<()> {
 }
 
 /// Writes `m` as binary little-endian PLY: float x/y/z/nx/ny/nz, `uchar int` face lists.
-pub fn write_ply(m: &RawMesh, path: &Path) -> Result<()> {
+pub fn write_ply(m: &HighMesh, path: &Path) -> Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| Error::output(path, e))?);
     let io = |e| Error::output(path, e);
     let header = format!(
@@ -214,7 +214,7 @@ pub(crate) fn cpu_seconds(children: bool) -> f64 {
 fn bake_in_memory(
     low: &Path,
     out: &Path,
-    mesh: RawMesh,
+    mesh: HighMesh,
     size: usize,
 ) -> Result<(bumpbake::bake::BakeReport, f64, f64, u64)> {
     use bumpbake::transfer::Settings;
@@ -236,13 +236,13 @@ fn bake_in_memory(
     Ok((r, t.elapsed().as_secs_f64(), cpu_seconds(false) - cpu, peak_bytes()))
 }
 
-/// `read_raw` on `path`, `runs` times in this process: the reader alone.
+/// `read_high` on `path`, `runs` times in this process: the reader alone.
 pub fn time_reader(path: &Path, runs: usize) -> Result<ReadTiming> {
     let mut times = Vec::new();
     let mut cpus = Vec::new();
     for _ in 0..runs.max(1) {
         let (t, cpu) = (std::time::Instant::now(), cpu_seconds(false));
-        let m = bumpbake::format::raw::read_raw(path, &bumpbake::scene::ReadOptions::default())?;
+        let m = bumpbake::transfer::high::read_high(path, &bumpbake::scene::ReadOptions::default())?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
         cpus.push((cpu_seconds(false) - cpu) * 1e3);
         drop(m);
@@ -394,7 +394,7 @@ pub fn table(rows: &[LargeRow]) -> String {
     }
     let timed: Vec<&LargeRow> = rows.iter().filter(|r| r.reader.is_some()).collect();
     if !timed.is_empty() {
-        s += "\nThe reader alone (read_raw in the bench's process, median of runs):\n";
+        s += "\nThe reader alone (read_high in the bench's process, median of runs):\n";
         s += "HIGH tris  from     file MB  runs  median ms  min ms   MB/s  CPU ms\n";
         for r in timed {
             let t = r.reader.as_ref().expect("filtered");

@@ -1,7 +1,12 @@
-//! A mesh as an OBJ or PLY file stores it, what both readers hand over: values in the file's own
-//! conventions (UVs v up), each attribute with its own index stream or, as PLY stores them, one
-//! value per position. The Scene builders (`obj/`, `ply/scene.rs`) and HIGH's reader (`raw.rs`)
-//! take it from there, and turn v down through [`v_down`], the one flip.
+//! What the OBJ and PLY readers share: the mesh as either file stores it ([`StoredMesh`]: values
+//! in the file's own conventions, UVs v up, each attribute with its own index stream or, as PLY
+//! stores them, one value per position), the numbers of their text ([`text_number`]) and the
+//! corners made a glTF primitive ([`to_gltf`]). The Scene builders (`obj/`, `ply/scene.rs`) and
+//! HIGH's reader (`transfer/high.rs`) take a `StoredMesh` from there, and turn v down through
+//! [`v_down`], the one flip.
+
+pub(super) mod text_number;
+pub(super) mod to_gltf;
 
 use crate::error::{Error, Result};
 use rayon::prelude::*;

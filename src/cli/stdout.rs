@@ -47,13 +47,13 @@ pub fn write_all(bytes: &[u8]) -> Result<()> {
 /// `println!` through [`print`]; an error returns from the calling function.
 macro_rules! outln {
     ($($t:tt)*) => {
-        $crate::cli::out::print(&format!("{}\n", format_args!($($t)*)))?
+        $crate::cli::stdout::print(&format!("{}\n", format_args!($($t)*)))?
     };
 }
 
 /// `print!` through [`print`].
 macro_rules! out {
     ($($t:tt)*) => {
-        $crate::cli::out::print(&format!($($t)*))?
+        $crate::cli::stdout::print(&format!($($t)*))?
     };
 }

@@ -1,7 +1,7 @@
 //! A stored mesh's corners as glTF: the primitive the OBJ and PLY scene builders both make
 //! (checked, normals made or made unit, welded, UVs turned v down), and the scene around it.
 
-use super::stored::v_down;
+use super::v_down;
 use crate::error::{Error, Result};
 use crate::scene::normals::{flat_normals, smooth_normals, unit_or_up};
 use crate::scene::weld::weld;
@@ -10,7 +10,7 @@ use serde_json::{json, Value};
 use std::path::Path;
 
 /// A scene with no meshes yet, read from the OBJ or PLY file at `path`.
-pub(super) fn empty_scene(
+pub(in crate::format) fn empty_scene(
     path: &Path,
     opts: &ReadOptions,
     format: SourceFormat,
@@ -33,7 +33,7 @@ pub(super) fn empty_scene(
     }
 }
 
-pub(super) fn set_nodes(scene: &mut Scene, nodes: Vec<Value>) {
+pub(in crate::format) fn set_nodes(scene: &mut Scene, nodes: Vec<Value>) {
     let roots: Vec<usize> = (0..nodes.len()).collect();
     set_key(&mut scene.json, "nodes", Value::Array(nodes));
     set_key(&mut scene.json, "scenes", json!([{ "nodes": roots }]));
@@ -43,7 +43,7 @@ pub(super) fn set_nodes(scene: &mut Scene, nodes: Vec<Value>) {
 /// One primitive's corners: flat values and, per attribute, an index per corner (an OBJ run
 /// renumbered in first-use order as tobj numbered a model's; a PLY mesh as stored).
 #[derive(Default)]
-pub(super) struct Model {
+pub(in crate::format) struct Model {
     pub positions: Vec<f32>,
     pub indices: Vec<u32>,
     pub normals: Vec<f32>,
@@ -55,7 +55,7 @@ pub(super) struct Model {
 /// The welded glTF primitive of `m`'s corners, UVs v down; normals from the file (made unit, a
 /// zero one pointing up) or, when it has none, made as `normals` asks. `name` names the object in
 /// messages.
-pub(super) fn build_primitive(
+pub(in crate::format) fn build_primitive(
     path: &Path,
     m: &Model,
     normals: NormalMode,

@@ -6,8 +6,8 @@
 //! applied here; OBJ and PLY have none), normals unit and through the normal matrix, UVs in glTF's
 //! convention (v down).
 
-use super::stored::{check_finite, check_finite_uv, runs, v_down, StoredMesh, MISSING};
 use crate::error::Result;
+use crate::format::mesh::{check_finite, check_finite_uv, runs, v_down, StoredMesh, MISSING};
 use crate::scene::nodes::instances;
 use crate::scene::normals::unit_or_up;
 use crate::scene::{to_triangle_list, PrimRef, ReadOptions, Scene};
@@ -27,7 +27,7 @@ pub struct Part {
 
 /// A mesh as HIGH holds it (see the module): world space, unit normals, v down.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct RawMesh {
+pub struct HighMesh {
     pub positions: Vec<[f32; 3]>,
     /// Unit normals, or empty when the file has none.
     pub normals: Vec<[f32; 3]>,
@@ -49,22 +49,22 @@ pub fn part_range(parts: &[Part], k: usize, triangles: usize) -> std::ops::Range
     parts[k].start as usize..end
 }
 
-/// Reads any mesh file bumpbake reads as a [`RawMesh`]: every triangle primitive the scene shows,
+/// Reads any mesh file bumpbake reads as a [`HighMesh`]: every triangle primitive the scene shows,
 /// in world space, one part per node (named after the node, else its mesh).
 ///
 /// OBJ and PLY take a fast path: the parsed arrays become the mesh as they are, with no Scene,
 /// no welding and no per-corner copies; of `opts`, OBJ uses only the progress reporter.
-pub fn read_raw(path: &Path, opts: &ReadOptions) -> Result<RawMesh> {
+pub fn read_high(path: &Path, opts: &ReadOptions) -> Result<HighMesh> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
-        "obj" => from_obj(path, super::obj::parse::parse_file(path, &opts.progress)?),
-        "ply" => from_ply(path, super::ply::read_file(path)?),
-        _ => from_scene(&Scene::read(path, opts)?),
+        "obj" => from_obj(path, crate::format::obj::parse::parse_file(path, &opts.progress)?),
+        "ply" => from_ply(path, crate::format::ply::read_file(path)?),
+        _ => from_scene(&crate::format::read(path, opts)?),
     }
 }
 
 /// An OBJ file's arrays as a mesh: parts at `o`/`g` and at `usemtl` changes.
-pub fn from_obj(path: &Path, d: StoredMesh) -> Result<RawMesh> {
+pub fn from_obj(path: &Path, d: StoredMesh) -> Result<HighMesh> {
     // The PLY parser checks its positions as it reads them; the OBJ parser leaves it to the glue,
     // which names the object on the Scene path.
     check_finite(path, &d.positions)?;
@@ -72,14 +72,14 @@ pub fn from_obj(path: &Path, d: StoredMesh) -> Result<RawMesh> {
 }
 
 /// A PLY mesh as one part named after the file.
-pub fn from_ply(path: &Path, p: StoredMesh) -> Result<RawMesh> {
-    from_stored(path, p, &super::ply::mesh_name(path))
+pub fn from_ply(path: &Path, p: StoredMesh) -> Result<HighMesh> {
+    from_stored(path, p, &crate::format::ply::mesh_name(path))
 }
 
 /// A stored mesh's arrays taken over: UVs turned v down, normals made unit (zero ones point up,
 /// as for every OBJ and PLY read). A kind of index some corners lack (a `vt` here and there) is
 /// dropped whole; values one per position get `triangles` as their index stream.
-fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<RawMesh> {
+fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<HighMesh> {
     // Whole triangles per item: a flattened parallel iterator costs more than the test itself.
     let indices = |own: Vec<[u32; 3]>, values: usize, triangles: &[[u32; 3]]| {
         if values == 0 {
@@ -96,7 +96,7 @@ fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<RawMesh> 
         .into_iter()
         .map(|r| Part { name: r.name, material: r.material, start: r.tris.start as u32 })
         .collect();
-    let mut out = RawMesh { positions: m.positions, triangles: m.triangles, parts, ..Default::default() };
+    let mut out = HighMesh { positions: m.positions, triangles: m.triangles, parts, ..Default::default() };
     if let Some(t) = normal_triangles {
         out.normals = m.normals;
         out.normals.par_iter_mut().for_each(|n| *n = unit_or_up(*n));
@@ -111,9 +111,9 @@ fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<RawMesh> 
     Ok(out)
 }
 
-/// A scene's shown triangle primitives as one [`RawMesh`] in world space.
-pub fn from_scene(scene: &Scene) -> Result<RawMesh> {
-    let mut out = RawMesh::default();
+/// A scene's shown triangle primitives as one [`HighMesh`] in world space.
+pub fn from_scene(scene: &Scene) -> Result<HighMesh> {
+    let mut out = HighMesh::default();
     let meshes = scene.json.get("meshes").and_then(|m| m.as_array()).map_or(0, |m| m.len());
     let mut with_normals = true;
     for inst in instances(scene) {
@@ -130,13 +130,12 @@ pub fn from_scene(scene: &Scene) -> Result<RawMesh> {
         let prims = mesh_json.get("primitives").and_then(|p| p.as_array()).map_or(0, |p| p.len());
         for k in 0..prims {
             let r = PrimRef { mesh: inst.mesh, primitive: k };
-            let pj = scene.prim_json(r);
             if !crate::scene::view::is_surface(scene, r) {
                 continue;
             }
             let p = to_triangle_list(scene.primitive(r)?);
             let base = out.positions.len() as u32;
-            let material = pj.get("material").and_then(|m| m.as_u64()).map(|m| m.to_string());
+            let material = scene.material_index(r).map(|m| m.to_string());
             out.parts.push(Part { name: name.clone(), material, start: out.triangles.len() as u32 });
             out.positions.extend(p.positions().into_iter().map(|q| place.point(Vec3::from(q)).to_array()));
             match p.attr("NORMAL") {

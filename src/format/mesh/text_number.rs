@@ -3,14 +3,14 @@
 //! twice.
 
 /// A blank inside a line, as OBJ and PLY text separate their tokens.
-pub(super) fn is_space(c: u8) -> bool {
+pub(in crate::format) fn is_space(c: u8) -> bool {
     matches!(c, b' ' | b'\t' | b'\r' | 0x0b | 0x0c)
 }
 
 /// A sign, then 1 to 18 decimal digits (so it never overflows), as `str::parse::<i64>` reads it
 /// without its UTF-8 check; `None` for anything else, a longer number included.
 #[inline]
-pub(super) fn short_int(t: &[u8]) -> Option<i64> {
+pub(in crate::format) fn short_int(t: &[u8]) -> Option<i64> {
     let (neg, digits) = match t.first()? {
         b'-' => (true, &t[1..]),
         b'+' => (false, &t[1..]),
@@ -33,7 +33,7 @@ pub(super) fn short_int(t: &[u8]) -> Option<i64> {
 /// The leading decimal digits of `b[i..]`, up to eight, read at once when eight bytes are there:
 /// how many there are (8 when there may be more) and their value.
 #[inline]
-pub(super) fn digits8(b: &[u8], i: usize) -> Option<(usize, u64)> {
+pub(in crate::format) fn digits8(b: &[u8], i: usize) -> Option<(usize, u64)> {
     let chunk = u64::from_le_bytes(b.get(i..i + 8)?.try_into().ok()?);
     let sub = chunk.wrapping_sub(0x3030_3030_3030_3030);
     // A byte's top bit is set in one of these if it is below '0', above '9' or not ASCII; bytes
