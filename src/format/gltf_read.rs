@@ -91,7 +91,7 @@ fn build(
     source_format: SourceFormat,
     opts: &ReadOptions,
 ) -> Result<Scene> {
-    crate::scene::shape::check(&json).map_err(|e| Error::input(path, e.0))?;
+    crate::scene::shape::check_and_settle(&mut json).map_err(|e| Error::input(path, e.0))?;
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mut buffers = Vec::new();
     let mut deps = Vec::new();
