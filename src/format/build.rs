@@ -30,6 +30,7 @@ pub(super) fn empty_scene(
         material_cache: Default::default(),
         absent_buffers: Default::default(),
         own_images: true,
+        decoded_steps: Default::default(),
     }
 }
 
