@@ -2,7 +2,9 @@
 
 use bumpbake::output::write_atomic;
 use bumpbake::preview::compare::{compare_with, Comparison, DiffKind};
-use bumpbake::preview::{render, Camera, CameraSpec, Light, Mips, Options, Params, Prepared, Resolve, Shading, View};
+use bumpbake::preview::{
+    render, Camera, CameraSpec, Facing, Light, Mips, Options, Params, Prepared, Resolve, Shading, View,
+};
 use bumpbake::scene::{ReadOptions, Scene};
 use bumpbake::{Error, Result};
 use clap::builder::PossibleValue;
@@ -42,12 +44,13 @@ pub struct Args {
     /// canvas's MSAA) or hdr (linear radiance averaged, then clamped: an HDR target's resolve).
     #[arg(long, value_enum, default_value_t = ResolveArg::from(Resolve::default()))]
     pub resolve: ResolveArg,
-    /// Camera rotation about +Y in degrees (0 looks from +Z).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub yaw: f32,
-    /// Camera elevation in degrees (positive looks down).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub pitch: f32,
+    /// Camera rotation about +Y in degrees (0 looks from +Z) [default: 0, or facing a flat
+    /// object].
+    #[arg(long, allow_negative_numbers = true)]
+    pub yaw: Option<f32>,
+    /// Camera elevation in degrees (positive looks down) [default: 0, or facing a flat object].
+    #[arg(long, allow_negative_numbers = true)]
+    pub pitch: Option<f32>,
     /// Camera distance from the centre of the bounds (default: fit the bounds).
     #[arg(long)]
     pub distance: Option<f32>,
@@ -165,9 +168,24 @@ pub struct Rendered {
     pub height: u32,
     pub ssaa: u32,
     pub triangles: usize,
+    pub camera: CameraReport,
     pub notes: Vec<String>,
     pub time_ms: f64,
     pub stages: Stages,
+}
+
+/// Where the picture was taken from.
+#[derive(serde::Serialize)]
+pub struct CameraReport {
+    /// Degrees, as used.
+    pub yaw: f32,
+    pub pitch: f32,
+    /// `front` (the default), `given` (--yaw or --pitch), or the view turned to face a flat
+    /// object: `top`, `bottom`, `right`, `left`, `back`.
+    pub view: &'static str,
+    /// Why the view was turned, when it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flat: Option<String>,
 }
 
 /// Where a preview's time went, in milliseconds.
@@ -214,8 +232,8 @@ pub fn run(a: Args) -> Result<u8> {
         ("--ambient", a.ambient),
         ("--specular", a.specular),
         ("--shininess", a.shininess),
-        ("--yaw", a.yaw),
-        ("--pitch", a.pitch),
+        ("--yaw", a.yaw.unwrap_or(0.0)),
+        ("--pitch", a.pitch.unwrap_or(0.0)),
     ] {
         if !v.is_finite() || (what != "--yaw" && what != "--pitch" && v < 0.0) {
             return Err(Error::usage(format!("preview: {what} {v} is not a usable value")));
@@ -239,7 +257,12 @@ pub fn run(a: Args) -> Result<u8> {
         ssaa: a.ssaa,
         mips: a.mips.into(),
         resolve: a.resolve.into(),
-        camera: CameraSpec { yaw: a.yaw, pitch: a.pitch, distance: a.distance, fov: a.fov },
+        camera: CameraSpec {
+            yaw: a.yaw.unwrap_or(0.0),
+            pitch: a.pitch.unwrap_or(0.0),
+            distance: a.distance,
+            fov: a.fov,
+        },
         lights,
         view,
         params: Params { ambient: a.ambient, specular: a.specular, shininess: a.shininess, shading: a.shading.into() },
@@ -294,7 +317,13 @@ pub fn run(a: Args) -> Result<u8> {
     let t_read = start.elapsed().as_secs_f64() * 1e3;
     let prep = Prepared::with_frames(&scene, matches!(opts.view, View::Tangent | View::Bitangent | View::Handedness))?;
     let t_prep = start.elapsed().as_secs_f64() * 1e3;
-    let cam = Camera::framed(prep.bounds, &opts.camera, opts.width, opts.height);
+    // The default view faces a flat object rather than its edge; angles the user gave stand.
+    let facing = match (a.yaw, a.pitch) {
+        (None, None) => Facing::for_flat(prep.bounds, prep.face_normal()),
+        _ => None,
+    };
+    let spec = facing.map_or(opts.camera, |f| opts.camera.facing(f, prep.bounds, opts.width, opts.height));
+    let cam = Camera::framed(prep.bounds, &spec, opts.width, opts.height);
     let frame = render(&prep, &cam, &opts);
     let t_render = start.elapsed().as_secs_f64() * 1e3;
     write_atomic(&a.output, &frame.to_png())?;
@@ -307,6 +336,16 @@ pub fn run(a: Args) -> Result<u8> {
         height: opts.height,
         ssaa: opts.ssaa,
         triangles: prep.triangle_count(),
+        camera: CameraReport {
+            yaw: spec.yaw,
+            pitch: spec.pitch,
+            view: match (facing, a.yaw.is_some() || a.pitch.is_some()) {
+                (Some(f), _) => f.name(),
+                (None, true) => "given",
+                (None, false) => "front",
+            },
+            flat: facing.map(|f| format!("flat in {}: {} view, from {}", f.plane(), f.name(), f.axis())),
+        },
         notes: prep.notes,
         time_ms: ms,
         stages: Stages {

@@ -26,7 +26,7 @@ pub mod shade;
 pub mod texture;
 pub mod views;
 
-pub use camera::{Camera, CameraSpec};
+pub use camera::{Camera, CameraSpec, Facing};
 pub use gather::Prepared;
 pub use shade::{Light, Params, Shading};
 pub use texture::Mips;
