@@ -503,7 +503,7 @@ fn faces(mesh: &Mesh) -> crate::error::Faulty<Vec<u32>> {
 mod tests {
     use super::*;
 
-    /// Values as Draco's dequantization makes them: `min + q * (range / (2^b - 1))` in f32.
+    /// Values as Draco's decoder makes them from quantized integers: `min + q * (range / (2^b - 1))` in f32.
     fn quantized(bits: u32, range: f32, min: [f32; 2], n: usize) -> Vec<f64> {
         let step = range / ((1u32 << bits) - 1) as f32;
         let top = (1u32 << bits) - 1;
