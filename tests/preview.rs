@@ -497,3 +497,46 @@ fn strips_and_fans_draw_as_the_triangles_they_make() {
     assert_eq!(fan_png, write("fan_list", &fan_list, None), "a fan draws as its triangle list");
     assert_ne!(strip_png, fan_png, "the two are different meshes (the strip is drawn at all)");
 }
+
+/// The most common test asset, a plane lying in XZ facing +Y, is drawn face-on by default (not
+/// edge-on from the front), and the report says which view was chosen; angles the user gives
+/// stand, and an object that is not flat keeps the front view.
+#[test]
+fn a_flat_plane_is_previewed_face_on_and_the_report_names_the_view() {
+    let dir = scratch_dir("preview_flat");
+    let (p, n, uv, idx) = grid(4);
+    // The grid turned from XY (facing +Z) into XZ (facing +Y): (x, y, 0) -> (x, 0, -y).
+    let p = p.iter().map(|q| [q[0], 0.0, -q[1]]).collect();
+    let n = n.iter().map(|_| [0.0, 1.0, 0.0]).collect();
+    let plane = dir.join("plane.glb");
+    write_mesh(&plane, (p, n, uv, idx), None, None);
+    let png = dir.join("plane.png");
+    let out = preview(&[s(&plane), "-o", s(&png), "--size", "64x64", "--json"]);
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["camera"]["view"], "top", "{report}");
+    assert_eq!(report["camera"]["pitch"], 90.0, "{report}");
+    assert!(report["camera"]["flat"].as_str().unwrap().contains("XZ"), "{report}");
+    let background = |path: &Path| {
+        let img = image::open(path).unwrap().to_rgb8();
+        let bg = [0.12f32, 0.12, 0.13].map(|c| (c * 255.0).round() as u8);
+        img.pixels().filter(|p| p.0 == bg).count() as f64 / (img.width() * img.height()) as f64
+    };
+    let empty = background(&png);
+    assert!(empty < 0.1, "the plane fills the image: {:.0}% background", empty * 100.0);
+    // The human report says it too.
+    let human = run_ok(&["preview", s(&plane), "-o", s(&png), "--size", "64x64"]);
+    let err = String::from_utf8_lossy(&human.stderr);
+    assert!(err.contains("camera: flat in XZ: top view, from +Y"), "{err}");
+    // Angles the user gives are kept, even edge-on.
+    let edge = dir.join("edge.png");
+    let out = preview(&[s(&plane), "-o", s(&edge), "--size", "64x64", "--pitch", "0", "--json"]);
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["camera"]["view"], "given", "{report}");
+    assert!(report["camera"].get("flat").is_none(), "{report}");
+    assert!(background(&edge) > 0.9, "edge-on as asked");
+    // Not flat: the front view, as before.
+    let cow = dir.join("cow.png");
+    let out = preview(&[s(&fixture("spot/spot.obj")), "-o", s(&cow), "--size", "32x32", "--json"]);
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["camera"], json!({ "yaw": 0.0, "pitch": 0.0, "view": "front" }), "{report}");
+}

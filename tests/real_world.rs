@@ -92,9 +92,14 @@ fn quantized_and_meshopt_files_get_mikktspace_tangents_on_their_decoded_geometry
 
 #[test]
 fn authored_tangents_carried_through_quantization_pass_strict_validation() {
-    for name in
-        ["mirror_small.glb", "mirror_small.quantize.glb", "mirror_small.gltfpack.glb", "mirror_small.gltfpack-c.glb"]
-    {
+    // Draco decodes to floats; its grid is found from the decoded values (docs/validate.md).
+    for name in [
+        "mirror_small.glb",
+        "mirror_small.quantize.glb",
+        "mirror_small.gltfpack.glb",
+        "mirror_small.gltfpack-c.glb",
+        "mirror_small.draco.glb",
+    ] {
         let o = run(&["validate", "--strict", "--format", "json", s(&real(name))]);
         assert_eq!(o.status.code(), Some(0), "{name}: {}", String::from_utf8_lossy(&o.stdout));
     }
@@ -253,8 +258,9 @@ fn every_command_on_every_corpus_file_succeeds_or_says_why() {
             let o = run(&["validate", "--strict", s(f)]);
             assert_eq!(o.status.code(), Some(0), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
         }
-        // Quantized authored frames pass strictly; turned or flipped ones still fail.
-        if ["quantize", "gltfpack", "meshopt"].iter().any(|k| stem.contains(k)) {
+        // Quantized authored frames pass strictly (Draco's like its meshopt twin's); turned or
+        // flipped ones still fail.
+        if ["quantize", "gltfpack", "meshopt", "draco"].iter().any(|k| stem.contains(k)) {
             let o = run(&["validate", "--strict", s(f)]);
             assert_eq!(o.status.code(), Some(0), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
             assert_spoilt_frames_fail(f, &scratch);
@@ -344,5 +350,89 @@ fn valid_quantized_tangents_are_kept_as_they_are() {
             (tb.format, tb.data),
             "{name}: the authored quantized tangents, byte for byte"
         );
+    }
+}
+
+/// The JSON and binary chunks of a GLB.
+fn glb_chunks(bytes: &[u8]) -> (serde_json::Value, Vec<u8>) {
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap()) as usize;
+    let json_len = u32_at(12);
+    let json = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let at = 20 + json_len;
+    let bin = if at + 8 <= bytes.len() { bytes[at + 8..at + 8 + u32_at(at)].to_vec() } else { Vec::new() };
+    (json, bin)
+}
+
+/// `v` with every number as a float: two documents that differ only in how they spell whole
+/// numbers compare equal.
+fn numbers_as_floats(v: &serde_json::Value) -> serde_json::Value {
+    use serde_json::Value;
+    match v {
+        Value::Number(n) => Value::from(n.as_f64().unwrap()),
+        Value::Array(a) => Value::Array(a.iter().map(numbers_as_floats).collect()),
+        Value::Object(o) => Value::Object(o.iter().map(|(k, x)| (k.clone(), numbers_as_floats(x))).collect()),
+        other => other.clone(),
+    }
+}
+
+fn integers_written_as_fractions(v: &mut serde_json::Value) {
+    use serde_json::Value;
+    match v {
+        Value::Number(n) if n.is_u64() => *v = Value::from(n.as_u64().unwrap() as f64),
+        Value::Array(a) => a.iter_mut().for_each(integers_written_as_fractions),
+        Value::Object(o) => o.values_mut().for_each(integers_written_as_fractions),
+        _ => {}
+    }
+}
+
+/// JSON has one number type: `1.0` is the integer 1 wherever glTF wants an integer (the Khronos
+/// validator reads it so). Every command reads a file whose integers are all written `N.0` as
+/// it reads the same file written with integers, writes the same outputs, and writes the
+/// integers it re-emits as integers.
+#[test]
+fn integers_written_with_a_zero_fraction_read_as_integers_in_every_command() {
+    let d = scratch_dir("real_whole_fractions");
+    let (json, data) = glb_chunks(&std::fs::read(real("mirror_small.glb")).unwrap());
+    let mut fractions = json.clone();
+    integers_written_as_fractions(&mut fractions);
+    let text = serde_json::to_string(&fractions).unwrap();
+    assert!(text.contains("\"count\":310.0") && text.contains("\"componentType\":5126.0"), "{text}");
+    let mut outputs = Vec::new();
+    for (name, doc) in [("integers", &json), ("fractions", &fractions)] {
+        let dir = d.join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut j = serde_json::to_vec(doc).unwrap();
+        j.resize(j.len().next_multiple_of(4), b' ');
+        std::fs::write(dir.join("in.glb"), glb_bytes(&j, &data)).unwrap();
+        let commands: &[&[&str]] = &[
+            &["tangents", "in.glb", "-o", "tangents.glb", "--overwrite", "-q"],
+            &["bake", "in.glb", "-o", "bake.glb", "-q"],
+            &["bake", "in.glb", "--from", "in.glb", "--size", "32", "-o", "from.glb", "-q"],
+            &["textures", "in.glb", "-o", "textures.glb", "-q"],
+            &["preview", "in.glb", "-o", "preview.png", "--size", "48x32", "-q"],
+            &["validate", "--format", "json", "in.glb"],
+            &["inspect", "--json", "in.glb"],
+        ];
+        let mut seen = Vec::new();
+        for args in commands {
+            let o = bin().args(*args).current_dir(&dir).output().unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(matches!(o.status.code(), Some(0 | 1)) && !err.contains("whole number"), "{name} {args:?}: {err}");
+            seen.push((args.join(" "), o.status.code(), o.stdout));
+        }
+        for f in ["tangents.glb", "bake.glb", "from.glb", "textures.glb"] {
+            let (j, b) = glb_chunks(&std::fs::read(dir.join(f)).unwrap());
+            // What the writer re-emits is an integer, however the input spelt it.
+            for a in j["accessors"].as_array().unwrap() {
+                assert!(a["count"].is_u64() && a["componentType"].is_u64(), "{name} {f}: {a}");
+            }
+            seen.push((f.to_string(), None, serde_json::to_vec(&numbers_as_floats(&j)).unwrap()));
+            seen.push((format!("{f} bin"), None, b));
+        }
+        seen.push(("preview.png".into(), None, std::fs::read(dir.join("preview.png")).unwrap()));
+        outputs.push(seen);
+    }
+    for (a, b) in outputs[0].iter().zip(&outputs[1]) {
+        assert!(a == b, "{}: differs between integers and fractions", a.0);
     }
 }

@@ -42,12 +42,13 @@ pub struct Args {
     /// canvas's MSAA) or hdr (linear radiance averaged, then clamped: an HDR target's resolve).
     #[arg(long, value_enum, default_value_t = ResolveArg::from(Resolve::default()))]
     pub resolve: ResolveArg,
-    /// Camera rotation about +Y in degrees (0 looks from +Z).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub yaw: f32,
-    /// Camera elevation in degrees (positive looks down).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub pitch: f32,
+    /// Camera rotation about +Y in degrees (0 looks from +Z) [default: 0, or facing a flat
+    /// object].
+    #[arg(long, allow_negative_numbers = true)]
+    pub yaw: Option<f32>,
+    /// Camera elevation in degrees (positive looks down) [default: 0, or facing a flat object].
+    #[arg(long, allow_negative_numbers = true)]
+    pub pitch: Option<f32>,
     /// Camera distance from the centre of the bounds (default: fit the bounds).
     #[arg(long)]
     pub distance: Option<f32>,
@@ -176,8 +177,8 @@ pub fn run(a: Args) -> Result<u8> {
         ("--ambient", a.ambient),
         ("--specular", a.specular),
         ("--shininess", a.shininess),
-        ("--yaw", a.yaw),
-        ("--pitch", a.pitch),
+        ("--yaw", a.yaw.unwrap_or(0.0)),
+        ("--pitch", a.pitch.unwrap_or(0.0)),
     ] {
         if !v.is_finite() || (what != "--yaw" && what != "--pitch" && v < 0.0) {
             return Err(Error::usage(format!("preview: {what} {v} is not a usable value")));
@@ -201,7 +202,12 @@ pub fn run(a: Args) -> Result<u8> {
         ssaa: a.ssaa,
         mips: a.mips.into(),
         resolve: a.resolve.into(),
-        camera: CameraSpec { yaw: a.yaw, pitch: a.pitch, distance: a.distance, fov: a.fov },
+        camera: CameraSpec {
+            yaw: a.yaw.unwrap_or(0.0),
+            pitch: a.pitch.unwrap_or(0.0),
+            distance: a.distance,
+            fov: a.fov,
+        },
         lights,
         view,
         params: Params { ambient: a.ambient, specular: a.specular, shininess: a.shininess, shading: a.shading.into() },
@@ -244,7 +250,7 @@ pub fn run(a: Args) -> Result<u8> {
         return Err(Error::usage("preview: --reference needs --compare"));
     }
     let input = a.input.as_ref().ok_or_else(|| Error::usage("preview: no input file"))?;
-    let done = render_file(input, &a.output, &opts, &read)?;
+    let done = render_file(input, &a.output, &opts, &read, a.yaw.is_some() || a.pitch.is_some())?;
     super::print::document(&done, a.json, a.quiet)?;
     Ok(0)
 }

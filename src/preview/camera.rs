@@ -22,6 +22,117 @@ impl Default for CameraSpec {
     }
 }
 
+/// A view along one axis, named as modelling tools name them (glTF's +Y up, +Z front).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Facing {
+    Front,
+    Back,
+    Right,
+    Left,
+    Top,
+    Bottom,
+}
+
+/// An object is flat when its thinnest extent is at most this share of its largest: seen along
+/// its plane, it would cover at most this share of the image.
+pub const FLAT_RATIO: f32 = 0.02;
+
+impl Facing {
+    pub fn name(self) -> &'static str {
+        match self {
+            Facing::Front => "front",
+            Facing::Back => "back",
+            Facing::Right => "right",
+            Facing::Left => "left",
+            Facing::Top => "top",
+            Facing::Bottom => "bottom",
+        }
+    }
+
+    /// The axis the view looks from, as `+Y`.
+    pub fn axis(self) -> &'static str {
+        match self {
+            Facing::Front => "+Z",
+            Facing::Back => "-Z",
+            Facing::Right => "+X",
+            Facing::Left => "-X",
+            Facing::Top => "+Y",
+            Facing::Bottom => "-Y",
+        }
+    }
+
+    /// The plane a flat object seen from this view lies in.
+    pub fn plane(self) -> &'static str {
+        match self {
+            Facing::Front | Facing::Back => "XY",
+            Facing::Right | Facing::Left => "YZ",
+            Facing::Top | Facing::Bottom => "XZ",
+        }
+    }
+
+    /// Yaw and pitch (degrees) of the view.
+    pub fn angles(self) -> (f32, f32) {
+        match self {
+            Facing::Front => (0.0, 0.0),
+            Facing::Back => (180.0, 0.0),
+            Facing::Right => (90.0, 0.0),
+            Facing::Left => (-90.0, 0.0),
+            Facing::Top => (0.0, 90.0),
+            Facing::Bottom => (0.0, -90.0),
+        }
+    }
+
+    /// The view that shows a flat object its face, or `None` when the object is not flat (or
+    /// the default front view already faces it). `bounds` are the object's; `face_normal` is the
+    /// sum of its triangles' area-weighted normals (by winding), which says which side of the
+    /// plane the faces look to: single-sided faces are only seen from there.
+    pub fn for_flat(bounds: (Vec3, Vec3), face_normal: Vec3) -> Option<Facing> {
+        let e = bounds.1 - bounds.0;
+        let axis = if e.x <= e.y && e.x <= e.z {
+            0
+        } else if e.y <= e.z {
+            1
+        } else {
+            2
+        };
+        if !(e.max_element() > 0.0 && e[axis] <= FLAT_RATIO * e.max_element()) {
+            return None;
+        }
+        let positive = face_normal[axis] >= 0.0;
+        let facing = match (axis, positive) {
+            (0, true) => Facing::Right,
+            (0, false) => Facing::Left,
+            (1, true) => Facing::Top,
+            (1, false) => Facing::Bottom,
+            (_, true) => Facing::Front,
+            (_, false) => Facing::Back,
+        };
+        (facing != Facing::Front).then_some(facing)
+    }
+}
+
+impl CameraSpec {
+    /// This spec looking from `facing` at a flat object of `bounds` in a `width` x `height`
+    /// image. Unless the spec sets a distance, the face's rectangle fills the view (with the
+    /// margin [`Camera::framed`] leaves): framing the bounding sphere would leave a square plane
+    /// at half the image.
+    pub fn facing(self, facing: Facing, bounds: (Vec3, Vec3), width: u32, height: u32) -> CameraSpec {
+        let (yaw, pitch) = facing.angles();
+        let e = bounds.1 - bounds.0;
+        // Extents across the image, up it, and along the view.
+        let (across, up, depth) = match facing {
+            Facing::Front | Facing::Back => (e.x, e.y, e.z),
+            Facing::Right | Facing::Left => (e.z, e.y, e.x),
+            Facing::Top | Facing::Bottom => (e.x, e.z, e.y),
+        };
+        let aspect = width.max(1) as f32 / height.max(1) as f32;
+        let half_fov = self.fov.clamp(1.0, 170.0).to_radians() * 0.5;
+        let half_fov_x = (half_fov.tan() * aspect).atan();
+        let fit = (up * 0.5 / half_fov.tan()).max(across * 0.5 / half_fov_x.tan()) * 1.02 + depth * 0.5;
+        CameraSpec { yaw, pitch, distance: self.distance.or(Some(fit.max(1e-6))), ..self }
+    }
+}
+
 /// A camera ready to project.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
@@ -76,5 +187,32 @@ mod tests {
             let p = c.clip(corner);
             assert!(p.w > 0.0 && (p.x / p.w).abs() <= 1.0 && (p.y / p.w).abs() <= 1.0 && (p.z / p.w).abs() <= 1.0);
         }
+    }
+
+    #[test]
+    fn a_flat_object_is_seen_from_the_side_its_faces_look_to() {
+        let plane = |lo: [f32; 3], hi: [f32; 3]| (Vec3::from(lo), Vec3::from(hi));
+        let xz = plane([-1.0, 0.0, -1.0], [1.0, 0.0, 1.0]);
+        assert_eq!(Facing::for_flat(xz, Vec3::Y), Some(Facing::Top));
+        assert_eq!(Facing::for_flat(xz, -Vec3::Y), Some(Facing::Bottom));
+        assert_eq!(Facing::for_flat(plane([0.0, -1.0, -1.0], [0.01, 1.0, 1.0]), Vec3::X), Some(Facing::Right));
+        let xy = plane([-1.0, -1.0, 0.0], [1.0, 1.0, 0.0]);
+        assert_eq!(Facing::for_flat(xy, Vec3::Z), None, "the default view faces it already");
+        assert_eq!(Facing::for_flat(xy, -Vec3::Z), Some(Facing::Back));
+        assert_eq!(Facing::for_flat(plane([-1.0; 3], [1.0; 3]), Vec3::Y), None, "a cube is not flat");
+        assert_eq!(Facing::for_flat(plane([0.0; 3], [0.0; 3]), Vec3::Y), None, "nor is a point");
+        // Seen from the top, the plane fills the view with +X to the right.
+        let spec = CameraSpec::default().facing(Facing::Top, xz, 100, 100);
+        let c = Camera::framed(xz, &spec, 100, 100);
+        assert!(c.eye.y > 1.0);
+        // Face-on and filling the view: +X right, the far edge (-Z) up, corners just inside.
+        let ndc = |p: Vec3| {
+            let q = c.clip(p);
+            (q.x / q.w, q.y / q.w)
+        };
+        let (x, y) = ndc(Vec3::new(1.0, 0.0, -1.0));
+        assert!(x > 0.95 && x <= 1.0 && y > 0.95 && y <= 1.0, "{x} {y}");
+        let (x, y) = ndc(Vec3::new(-1.0, 0.0, 1.0));
+        assert!(x < -0.95 && y < -0.95, "{x} {y}");
     }
 }

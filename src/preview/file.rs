@@ -3,7 +3,7 @@
 //! (`docs/json.md`, preview).
 
 use super::compare::{compare_with, Comparison, DiffKind};
-use super::{render, Camera, Options, Prepared, View};
+use super::{render, Camera, Facing, Options, Prepared, View};
 use crate::output::write_atomic;
 use crate::scene::ReadOptions;
 use crate::Result;
@@ -20,9 +20,24 @@ pub struct Rendered {
     pub height: u32,
     pub ssaa: u32,
     pub triangles: usize,
+    pub camera: CameraReport,
     pub notes: Vec<String>,
     pub time_ms: f64,
     pub stages: Stages,
+}
+
+/// Where the picture was taken from.
+#[derive(Debug, serde::Serialize)]
+pub struct CameraReport {
+    /// Degrees, as used.
+    pub yaw: f32,
+    pub pitch: f32,
+    /// `front` (the default), `given` (angles the caller chose), or the view turned to face a
+    /// flat object: `top`, `bottom`, `right`, `left`, `back`.
+    pub view: &'static str,
+    /// Why the view was turned, when it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flat: Option<String>,
 }
 
 /// Where a preview's time went, in milliseconds.
@@ -44,14 +59,24 @@ pub struct Compared {
     pub comparison: Comparison,
 }
 
-/// Renders `input` with `opts` and writes the picture to `output` as PNG.
-pub fn render_file(input: &Path, output: &Path, opts: &Options, read: &ReadOptions) -> Result<Rendered> {
+/// Renders `input` with `opts` and writes the picture to `output` as PNG. `angles_given`: the
+/// camera's yaw and pitch are the caller's; otherwise the default view turns to face a flat
+/// object rather than its edge.
+pub fn render_file(
+    input: &Path,
+    output: &Path,
+    opts: &Options,
+    read: &ReadOptions,
+    angles_given: bool,
+) -> Result<Rendered> {
     let start = Instant::now();
     let scene = crate::format::read(input, read)?;
     let t_read = start.elapsed().as_secs_f64() * 1e3;
     let prep = Prepared::with_frames(&scene, matches!(opts.view, View::Tangent | View::Bitangent | View::Handedness))?;
     let t_prep = start.elapsed().as_secs_f64() * 1e3;
-    let cam = Camera::framed(prep.bounds, &opts.camera, opts.width, opts.height);
+    let facing = if angles_given { None } else { Facing::for_flat(prep.bounds, prep.face_normal()) };
+    let spec = facing.map_or(opts.camera, |f| opts.camera.facing(f, prep.bounds, opts.width, opts.height));
+    let cam = Camera::framed(prep.bounds, &spec, opts.width, opts.height);
     let frame = render(&prep, &cam, opts);
     let t_render = start.elapsed().as_secs_f64() * 1e3;
     write_atomic(output, &frame.to_png())?;
@@ -64,6 +89,16 @@ pub fn render_file(input: &Path, output: &Path, opts: &Options, read: &ReadOptio
         height: opts.height,
         ssaa: opts.ssaa,
         triangles: prep.triangle_count(),
+        camera: CameraReport {
+            yaw: spec.yaw,
+            pitch: spec.pitch,
+            view: match (facing, angles_given) {
+                (Some(f), _) => f.name(),
+                (None, true) => "given",
+                (None, false) => "front",
+            },
+            flat: facing.map(|f| format!("flat in {}: {} view, from {}", f.plane(), f.name(), f.axis())),
+        },
         notes: prep.notes,
         time_ms: ms,
         stages: Stages {

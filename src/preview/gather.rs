@@ -174,6 +174,22 @@ impl Prepared {
         Ok(Prepared { draws, materials: gatherer.materials, bounds: (lo, hi), notes: gatherer.notes })
     }
 
+    /// The sum of every drawn triangle's normal by winding, weighted by area: which way the
+    /// faces look, on the whole.
+    pub fn face_normal(&self) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for d in &self.draws {
+            for t in &d.triangles {
+                let [a, b, c] = t.map(|i| d.positions[i as usize]);
+                let n = (b - a).cross(c - a);
+                if n.is_finite() {
+                    sum += n;
+                }
+            }
+        }
+        sum
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.draws.iter().map(|d| d.triangles.len()).sum()
     }

@@ -29,8 +29,8 @@ pub mod shade;
 pub mod texture;
 pub mod views;
 
-pub use camera::{Camera, CameraSpec};
-pub use file::{compare_files, render_file, Compared, Comparing, Rendered, Stages};
+pub use camera::{Camera, CameraSpec, Facing};
+pub use file::{compare_files, render_file, CameraReport, Compared, Comparing, Rendered, Stages};
 pub use gather::Prepared;
 pub use shade::{Light, Params, Shading};
 pub use texture::Mips;

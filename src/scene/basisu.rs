@@ -130,13 +130,7 @@ impl Scene {
     /// Lists `KHR_texture_basisu` in `extensionsUsed`, and in `extensionsRequired` when
     /// `required` (no texture keeps a core fallback).
     pub fn use_basisu(&mut self, required: bool) {
-        let lists: &[&str] = if required { &["extensionsUsed", "extensionsRequired"] } else { &["extensionsUsed"] };
-        for key in lists {
-            let list = super::array_mut(&mut self.json, key);
-            if !list.iter().any(|e| e.as_str() == Some(BASISU)) {
-                list.push(json!(BASISU));
-            }
-        }
+        list_basisu(&mut self.json, required);
     }
 
     /// Image-format extensions no texture uses any more leave `extensionsUsed` and
@@ -200,4 +194,38 @@ impl Scene {
     pub fn image_label(&self, i: usize) -> Option<String> {
         self.array("images").get(i).and_then(|img| img.get("name")).and_then(Value::as_str).map(String::from)
     }
+}
+
+/// [`Scene::use_basisu`] on a document.
+fn list_basisu(json: &mut Value, required: bool) {
+    let lists: &[&str] = if required { &["extensionsUsed", "extensionsRequired"] } else { &["extensionsUsed"] };
+    for key in lists {
+        let list = super::array_mut(json, key);
+        if !list.iter().any(|e| e.as_str() == Some(BASISU)) {
+            list.push(json!(BASISU));
+        }
+    }
+}
+
+/// Every texture whose core `source` is one of the KTX2 images `ktx2` names it through
+/// `KHR_texture_basisu` instead, the one place glTF lets a KTX2 image be named; the extension
+/// is then used and required (such a texture has no PNG or JPEG source to fall back on).
+/// Textures that already carry the extension are left as they are. Returns whether any changed.
+pub fn core_ktx2_to_basisu(json: &mut Value, ktx2: &BTreeSet<usize>) -> bool {
+    let mut changed = false;
+    for t in json.get_mut("textures").and_then(Value::as_array_mut).into_iter().flatten() {
+        let Some(src) = t.get("source").and_then(as_index).filter(|i| ktx2.contains(i)) else { continue };
+        if t.pointer(&format!("/extensions/{BASISU}")).is_some() {
+            continue;
+        }
+        let Some(o) = t.as_object_mut() else { continue };
+        o.remove("source");
+        let exts = o.entry("extensions").or_insert_with(|| json!({}));
+        set_key(exts, BASISU, json!({ "source": src }));
+        changed = true;
+    }
+    if changed {
+        list_basisu(json, true);
+    }
+    changed
 }

@@ -110,6 +110,10 @@ pub struct Scene {
     pub absent_buffers: std::collections::BTreeSet<usize>,
     /// [`Scene::materials`], once read.
     pub(crate) material_cache: std::sync::OnceLock<material::Materials>,
+    /// Float accessors the reader decoded from quantized data (Draco) -> the step of the grid
+    /// their values lie on, in the accessor's units: what quantization explains, as a normalized
+    /// integer's step does.
+    pub decoded_steps: std::collections::BTreeMap<usize, f64>,
 }
 
 /// A height map a material wants as its bump map.

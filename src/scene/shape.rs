@@ -2,13 +2,17 @@
 //! writing, has the type the glTF 2.0 schema gives it, and every index names an entry that
 //! exists.
 //!
-//! The readers run [`check`] once, before anything else looks at the document, so every command
-//! refuses the same files with the same message (a JSON pointer and what was found there), and
-//! the code after it may take the shapes it reads for granted without ever panicking. What the
+//! The readers run [`check_and_settle`] once, before anything else looks at the document, so
+//! every command refuses the same files with the same message (a JSON pointer and what was found
+//! there), and the code after it may take the shapes it reads for granted without ever
+//! panicking. A whole number written with a fraction (`1.0`) where the schema wants an integer is
+//! that integer: it is rewritten as one there, and only there. What the
 //! rule does not cover (unknown extensions, `extras`, cameras' fields) is passed through as read.
 //! Values the schema makes optional are only checked when present.
 
 use serde_json::{Map, Value};
+use std::cell::RefCell;
+use std::collections::HashSet;
 
 /// Where a document breaks the rule, as one line: `meshes/4/primitives/0: expected an object,
 /// found an array`.
@@ -45,8 +49,25 @@ const MAX_MODE: u64 = 6;
 
 /// Checks the document against the reading rule.
 pub fn check(json: &Value) -> Checked {
+    written_as_fractions(json).map(|_| ())
+}
+
+/// Checks the document and rewrites every whole number it holds where the schema wants an
+/// integer but the file wrote a fraction (`1.0`, `3e0`) as that integer, so that the code after
+/// it reads integers one way. Numbers anywhere else are left as written.
+pub fn check_and_settle(json: &mut Value) -> Checked {
+    let settle = written_as_fractions(json)?;
+    if !settle.is_empty() {
+        settle_integers(json, &settle);
+    }
+    Ok(())
+}
+
+/// The identities (addresses) of the integer-typed values written with a fraction; `json` is
+/// not changed between collecting and rewriting them, so the addresses stay those values'.
+fn written_as_fractions(json: &Value) -> Result<HashSet<usize>, ShapeError> {
     let root = json.as_object().ok_or_else(|| ShapeError("the glTF JSON is not an object".into()))?;
-    let c = Checker { root };
+    let c = Checker { root, fractions: RefCell::new(HashSet::new()) };
     for key in LISTS {
         if let Some(v) = root.get(*key) {
             for (i, item) in c.array(v, key)?.iter().enumerate() {
@@ -78,7 +99,35 @@ pub fn check(json: &Value) -> Checked {
     c.each("scenes", Checker::scene)?;
     c.each("skins", Checker::skin)?;
     c.each("animations", Checker::animation)?;
-    Ok(())
+    Ok(c.fractions.into_inner())
+}
+
+fn settle_integers(v: &mut Value, settle: &HashSet<usize>) {
+    if settle.contains(&(v as *const Value as usize)) {
+        if let Some(n) = whole(v) {
+            *v = Value::from(n);
+        }
+        return;
+    }
+    match v {
+        Value::Array(a) => a.iter_mut().for_each(|x| settle_integers(x, settle)),
+        Value::Object(o) => o.values_mut().for_each(|x| settle_integers(x, settle)),
+        _ => {}
+    }
+}
+
+/// Largest whole number a fraction may be written as and still be read exactly (2^53, the
+/// limit JSON readers that hold numbers as doubles share).
+const MAX_EXACT: f64 = 9_007_199_254_740_992.0;
+
+/// `v` as a whole number 0 or more, however it is written: `1`, `1.0` and `1e0` are one value
+/// (JSON has one number type; the glTF validator reads them alike). Fractions past 2^53 are
+/// refused rather than rounded.
+fn whole(v: &Value) -> Option<u64> {
+    v.as_u64().or_else(|| {
+        let f = v.as_f64().filter(|_| !v.is_i64())?;
+        (f.fract() == 0.0 && (0.0..=MAX_EXACT).contains(&f)).then_some(f as u64)
+    })
 }
 
 fn kind(v: &Value) -> &'static str {
@@ -103,6 +152,8 @@ fn found(at: &str, expected: &str, v: &Value) -> ShapeError {
 
 struct Checker<'a> {
     root: &'a Map<String, Value>,
+    /// Integer-typed values the file wrote with a fraction, by address.
+    fractions: RefCell<HashSet<usize>>,
 }
 
 impl Checker<'_> {
@@ -128,13 +179,21 @@ impl Checker<'_> {
     }
 
     fn uint(&self, v: &Value, at: &str) -> Result<u64, ShapeError> {
-        v.as_u64().ok_or_else(|| found(at, "a whole number 0 or more", v))
+        self.whole(v).ok_or_else(|| found(at, "a whole number 0 or more", v))
     }
 
     /// An index into the top-level list `list`.
     fn index(&self, v: &Value, at: &str, list: &str) -> Checked {
-        let i = v.as_u64().ok_or_else(|| found(at, "an index (a whole number 0 or more)", v))?;
+        let i = self.whole(v).ok_or_else(|| found(at, "an index (a whole number 0 or more)", v))?;
         self.in_range(i, at, list)
+    }
+
+    fn whole(&self, v: &Value) -> Option<u64> {
+        let n = whole(v)?;
+        if !v.is_u64() {
+            self.fractions.borrow_mut().insert(v as *const Value as usize);
+        }
+        Some(n)
     }
 
     fn in_range(&self, i: u64, at: &str, list: &str) -> Checked {
@@ -380,7 +439,7 @@ impl Checker<'_> {
                 ("mode", Uint),
             ],
         )?;
-        if let Some(m) = p.get("mode").and_then(Value::as_u64).filter(|&m| m > MAX_MODE) {
+        if let Some(m) = p.get("mode").and_then(whole).filter(|&m| m > MAX_MODE) {
             return Err(ShapeError(format!("{at}/mode: {m} is not a glTF primitive mode (0 to 6)")));
         }
         if let Some(ts) = p.get("targets") {
@@ -466,7 +525,7 @@ impl Checker<'_> {
                 let at = format!("{at}/channels/{i}");
                 let ch = self.object(ch, &at)?;
                 self.fields(ch, &at, &[("sampler", Kind::Uint), ("target", Kind::Object)])?;
-                if let Some(s) = ch.get("sampler").and_then(Value::as_u64).filter(|&s| s >= samplers.len() as u64) {
+                if let Some(s) = ch.get("sampler").and_then(whole).filter(|&s| s >= samplers.len() as u64) {
                     return Err(ShapeError(format!("{at}/sampler: the animation has no sampler {s}")));
                 }
                 if let Some(t) = ch.get("target").and_then(Value::as_object) {
@@ -553,5 +612,30 @@ mod tests {
         assert_eq!(e, "meshes/0/primitives/0/mode: 7 is not a glTF primitive mode (0 to 6)");
         let e = err(|j| *j.pointer_mut("/accessors").unwrap() = json!(null));
         assert_eq!(e, "accessors: expected an array, found null");
+        let e = err(|j| *j.pointer_mut("/meshes/0/primitives/0/material").unwrap() = json!(0.5));
+        assert_eq!(e, "meshes/0/primitives/0/material: expected an index (a whole number 0 or more), found 0.5");
+        let e = err(|j| set_key(j.pointer_mut("/meshes/0/primitives/0").unwrap(), "mode", json!(7.0)));
+        assert_eq!(e, "meshes/0/primitives/0/mode: 7 is not a glTF primitive mode (0 to 6)");
+        let e = err(|j| *j.pointer_mut("/accessors/0/count").unwrap() = json!(1e300));
+        assert_eq!(e, "accessors/0/count: expected a whole number 0 or more, found 1e+300");
+    }
+
+    #[test]
+    fn whole_numbers_written_as_fractions_become_integers_where_the_schema_wants_one() {
+        let mut j = base();
+        *j.pointer_mut("/accessors/0/count").unwrap() = json!(3.0);
+        *j.pointer_mut("/meshes/0/primitives/0/material").unwrap() = json!(0.0);
+        *j.pointer_mut("/nodes/0/children").unwrap() = json!([]);
+        *j.pointer_mut("/scenes/0/nodes/0").unwrap() = json!(-0.0);
+        set_key(j.pointer_mut("/meshes/0/primitives/0/attributes").unwrap(), "A/B~", json!(0.0));
+        set_key(j.pointer_mut("/materials/0").unwrap(), "alphaCutoff", json!(1.0));
+        assert_eq!(check_and_settle(&mut j), Ok(()));
+        let ints = ["/accessors/0/count", "/meshes/0/primitives/0/material", "/scenes/0/nodes/0"];
+        for p in ints.into_iter().chain(["/meshes/0/primitives/0/attributes/A~1B~0"]) {
+            assert!(j.pointer(p).unwrap().is_u64(), "{p}: {}", j.pointer(p).unwrap());
+        }
+        assert_eq!(j["accessors"][0]["count"], json!(3));
+        // A float the schema wants as a float keeps its spelling.
+        assert_eq!(serde_json::to_string(&j["materials"][0]["alphaCutoff"]).unwrap(), "1.0");
     }
 }

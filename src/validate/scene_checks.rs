@@ -79,7 +79,12 @@ pub fn run(scene: &Scene, opts: &Options) -> Result<Vec<Subject>> {
         // Compared as a renderer sees them (the view's values): quantized normals made unit, UVs
         // through the transform of the texture the tangents serve (the UVs the tangent must follow).
         let uvs = view.tangent_uvs();
-        let step = |name: &str| p.attr(name).map_or(0.0, |s| s.step() as f64);
+        let step = |name: &str| {
+            let decoded =
+                scene.prim_json(r).get("attributes").and_then(|a| a.get(name)).and_then(crate::scene::as_index);
+            let decoded = decoded.and_then(|a| scene.decoded_steps.get(&a)).copied().unwrap_or(0.0);
+            p.attr(name).map_or(0.0, |s| s.step() as f64).max(decoded)
+        };
         let quant = Quant {
             position: step("POSITION"),
             normal: step("NORMAL"),

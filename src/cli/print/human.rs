@@ -387,6 +387,9 @@ impl Human for Rendered {
             self.triangles,
             self.time_ms
         );
+        if let Some(why) = &self.camera.flat {
+            s += &format!("  camera: {why}\n");
+        }
         let t = &self.stages;
         s += &format!(
             "  read {:.0} ms, prepare {:.0} ms, render {:.0} ms, write {:.0} ms\n",

@@ -8,7 +8,11 @@
 use crate::error::{Error, Result};
 use crate::scene::accessor::{component_count, component_size, FLOAT, UNSIGNED_INT, UNSIGNED_SHORT};
 use crate::scene::as_index;
-use draco_core::{DataType, DecodeLimits, DecoderBuffer, ErrorKind, Mesh, MeshDecoder, PointAttribute, PointIndex};
+use draco_core::normal_compression_utils::OctahedronToolBox;
+use draco_core::{
+    DataType, DecodeLimits, DecoderBuffer, ErrorKind, GeometryAttributeType, Mesh, MeshDecoder, PointAttribute,
+    PointIndex,
+};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -20,9 +24,14 @@ const POINTS: u64 = 0;
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 
+/// Float accessors decoded from a quantized Draco attribute -> the step of the grid the
+/// quantization left their values on (see [`grid_step`]).
+pub type Steps = BTreeMap<usize, f64>;
+
 /// Decodes every Draco-compressed primitive of `json` into a new buffer appended to `buffers`,
-/// and removes the extension. Returns whether there was anything to decode.
-pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut Vec<Vec<u8>>) -> Result<bool> {
+/// and removes the extension. Returns the quantization steps of what it decoded, or `None` when
+/// there was nothing to decode.
+pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut Vec<Vec<u8>>) -> Result<Option<Steps>> {
     let mut prims = Vec::new();
     for (m, mesh) in json.get("meshes").and_then(|m| m.as_array()).into_iter().flatten().enumerate() {
         for (p, prim) in mesh.get("primitives").and_then(|p| p.as_array()).into_iter().flatten().enumerate() {
@@ -32,9 +41,9 @@ pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut Vec<Vec<u8>>) -> 
         }
     }
     if prims.is_empty() {
-        return Ok(false);
+        return Ok(None);
     }
-    let mut out = Out { buffer: buffers.len(), bytes: Vec::new(), written: BTreeMap::new() };
+    let mut out = Out { buffer: buffers.len(), bytes: Vec::new(), written: BTreeMap::new(), steps: Steps::new() };
     for (m, p) in prims {
         let bad = |msg: String| Error::input(path, format!("mesh {m} primitive {p}: {msg}"));
         let at = format!("/meshes/{m}/primitives/{p}");
@@ -60,7 +69,7 @@ pub fn decode_all(path: &Path, json: &mut Value, buffers: &mut Vec<Vec<u8>>) -> 
             }
         }
     }
-    Ok(true)
+    Ok(Some(out.steps))
 }
 
 /// Decodes one Draco stream, stopping at `limits`.
@@ -131,6 +140,7 @@ struct Out {
     bytes: Vec<u8>,
     /// Accessor already given data by a decoded primitive -> where in `bytes` that data lies.
     written: BTreeMap<usize, std::ops::Range<usize>>,
+    steps: Steps,
 }
 
 impl Out {
@@ -168,7 +178,11 @@ impl Out {
             let mut data = Vec::with_capacity(n * stride);
             let float = !attr.data_type().is_integral();
             let mut bounds = Bounds::new(comps);
+            let mut values = Vec::with_capacity(if float { n * comps } else { 0 });
             for_each_value(attr, n, comps, &mut |v| {
+                if float {
+                    values.push(v);
+                }
                 bounds.add(put(&mut data, ct, v, float)?);
                 if bounds.at == 0 {
                     data.extend_from_slice(&[0; 3][..pad]);
@@ -178,6 +192,10 @@ impl Out {
             .map_err(|e| format!("attribute {name} (accessor {acc}): {e}"))?;
             let acc = self.assign(json, acc, data, ARRAY_BUFFER, (pad != 0).then_some(stride));
             bounds.replace(json, acc, ct);
+            let normal = attr.attribute_type() == GeometryAttributeType::Normal;
+            if let Some(step) = grid_step(&values, comps, normal) {
+                self.steps.insert(acc, step);
+            }
             if let Some(attrs) = prim.get_mut("attributes") {
                 crate::scene::set_key(attrs, name, json!(acc));
             }
@@ -371,6 +389,63 @@ fn put(out: &mut Vec<u8>, ct: u32, v: f64, from_float: bool) -> crate::error::Fa
     Ok(v)
 }
 
+/// Fewer distinct values than this fit coarse grids by chance: such data is judged as floats.
+const GRID_MIN_VALUES: usize = 16;
+
+/// The step of the grid Draco's quantization put float values on, found from the values: the
+/// decoder does not hand on the bits the stream declares, and the grid is what they imply.
+///
+/// Draco stores a quantized attribute as integers `q` in `0..=2^b - 1` and decodes
+/// `v = min_c + q * range / (2^b - 1)`, with one `range` (the largest extent of any component)
+/// and each component's own minimum; the step is the coarsest such grid all values lie on. A
+/// normal is stored as a point of a `2^b - 1` grid on the octahedron instead; its step is the
+/// per-component step whose angle ([`crate::validate::frames::Quant::vector_angle`]) bounds
+/// that grid's: a point off by half a cell in each octahedral coordinate turns by at most
+/// `sqrt(6) * 2 / (2^b - 2) * sqrt(3)/2`. `None` for data on no grid (Draco's lossless floats)
+/// and for too few values to tell.
+pub fn grid_step(values: &[f64], comps: usize, normal: bool) -> Option<f64> {
+    let mut distinct: Vec<u64> = values.iter().map(|v| v.to_bits()).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    if comps == 0 || distinct.len() < GRID_MIN_VALUES || values.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    if normal && comps == 3 {
+        return octahedral_bits(values).map(|b| 6f64.sqrt() * 2.0 / ((1u64 << b) - 2) as f64);
+    }
+    let mut lo = vec![f64::INFINITY; comps];
+    let mut hi = vec![f64::NEG_INFINITY; comps];
+    for (i, &v) in values.iter().enumerate() {
+        lo[i % comps] = lo[i % comps].min(v);
+        hi[i % comps] = hi[i % comps].max(v);
+    }
+    let range = lo.iter().zip(&hi).map(|(l, h)| h - l).fold(0.0, f64::max) as f32;
+    // Past 24 bits a step is below a float's own rounding: every value fits, and says nothing.
+    (1..=24).find_map(|b| {
+        let step = (range / ((1u32 << b) - 1) as f32) as f64;
+        let on_grid = |(i, &v): (usize, &f64)| {
+            let q = (v - lo[i % comps]) / step;
+            // The decoder adds in f32: a few of its ulps off the grid is on it.
+            (q - q.round()).abs() * step <= 4.0 * f32::EPSILON as f64 * v.abs().max(lo[i % comps].abs()) + 0.01 * step
+        };
+        (step > 0.0 && values.iter().enumerate().all(on_grid)).then_some(step)
+    })
+}
+
+/// The fewest octahedral bits whose grid every (unit) normal in `values` lies on.
+fn octahedral_bits(values: &[f64]) -> Option<u32> {
+    let normals: Vec<[f32; 3]> = values.chunks_exact(3).map(|n| [n[0] as f32, n[1] as f32, n[2] as f32]).collect();
+    (2..=16).find(|&b| {
+        let mut tools = OctahedronToolBox::new();
+        tools.set_quantization_bits(b as i32);
+        normals.iter().all(|n| {
+            let (s, t) = tools.float_vector_to_quantized_octahedral_coords(n);
+            let back = tools.quantized_octahedral_coords_to_unit_vector(s, t);
+            back.iter().zip(n).all(|(a, b)| (a - b).abs() <= 1e-5)
+        })
+    })
+}
+
 /// Per-component bounds of the values written. An accessor's `min` and `max` were computed by the
 /// encoder from the data before quantization, which the decoded data can exceed; glTF wants the
 /// bounds of the data the file holds.
@@ -422,4 +497,52 @@ fn faces(mesh: &Mesh) -> crate::error::Faulty<Vec<u32>> {
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values as Draco's decoder makes them from quantized integers: `min + q * (range / (2^b - 1))` in f32.
+    fn quantized(bits: u32, range: f32, min: [f32; 2], n: usize) -> Vec<f64> {
+        let step = range / ((1u32 << bits) - 1) as f32;
+        let top = (1u32 << bits) - 1;
+        let q = |i: usize, k: u32| ((i as u32).wrapping_mul(2_654_435_761u32.wrapping_mul(k)) >> 7) % (top + 1);
+        (0..n).flat_map(|i| [min[0] + q(i, 1) as f32 * step, min[1] + q(i, 3) as f32 * step]).map(f64::from).collect()
+    }
+
+    #[test]
+    fn the_grid_of_quantized_values_is_found_from_the_values() {
+        for bits in [8, 12, 14] {
+            let mut v = quantized(bits, 2.5, [-1.25, 0.3], 400);
+            // The full range is reached on one component, as the encoder's range is its extent.
+            v.extend([-1.25, 0.3, 1.25, 0.3]);
+            let step = grid_step(&v, 2, false).unwrap_or_else(|| panic!("{bits} bits: no grid"));
+            let want = (2.5f32 / ((1u32 << bits) - 1) as f32) as f64;
+            assert!((step - want).abs() < want * 1e-4, "{bits} bits: step {step}, want {want}");
+        }
+        // Floats on no grid, and too few values to tell, are floats.
+        let noise: Vec<f64> = (0..300).map(|i| ((i as f64 * 0.754_877_666).fract() * 7.3).sin()).collect();
+        let step = grid_step(&noise, 3, false);
+        assert!(step.is_none_or(|s| s < 1e-5), "{step:?}");
+        assert_eq!(grid_step(&[0.0, 1.0, 0.5, 0.25], 2, false), None);
+    }
+
+    #[test]
+    fn normals_on_the_octahedral_grid_give_its_bits() {
+        let mut tools = OctahedronToolBox::new();
+        tools.set_quantization_bits(10);
+        let mut v = Vec::new();
+        for i in 0..200 {
+            let (a, b) = (i as f32 * 0.37, i as f32 * 0.11);
+            let n = [a.cos() * b.cos(), a.sin() * b.cos(), b.sin()];
+            let (s, t) = tools.float_vector_to_quantized_octahedral_coords(&n);
+            v.extend(tools.quantized_octahedral_coords_to_unit_vector(s, t).map(f64::from));
+        }
+        let step = grid_step(&v, 3, true).unwrap();
+        assert!((step - 6f64.sqrt() * 2.0 / 1022.0).abs() < 1e-9, "{step}");
+        // The bound covers the grid's real error: every normal within its angle of the input.
+        let angle = crate::validate::frames::Quant::vector_angle(step).to_degrees();
+        assert!(angle > 0.2 && angle < 0.3, "{angle}°");
+    }
 }

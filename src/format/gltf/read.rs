@@ -91,7 +91,7 @@ fn build(
     source_format: SourceFormat,
     opts: &ReadOptions,
 ) -> Result<Scene> {
-    crate::scene::shape::check(&json).map_err(|e| Error::input(path, e.0))?;
+    crate::scene::shape::check_and_settle(&mut json).map_err(|e| Error::input(path, e.0))?;
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let mut buffers = Vec::new();
     let mut deps = Vec::new();
@@ -137,7 +137,8 @@ fn build(
     if meshopt::decode_all(path, &mut json, &mut buffers)? {
         notes.push(format!("{}: decoded; the output is written without it (uncompressed)", meshopt::EXT));
     }
-    if draco::decode_all(path, &mut json, &mut buffers)? {
+    let decoded_steps = draco::decode_all(path, &mut json, &mut buffers)?;
+    if decoded_steps.is_some() {
         notes.push(format!("{}: decoded; the output is written without it (uncompressed)", draco::EXT));
     }
     let scene = Scene {
@@ -154,6 +155,7 @@ fn build(
         material_cache: Default::default(),
         absent_buffers: absent,
         own_images: false,
+        decoded_steps: decoded_steps.unwrap_or_default(),
     };
     check_views(&scene)?;
     Ok(scene)

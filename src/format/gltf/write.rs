@@ -78,6 +78,13 @@ pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(O
     let mut new_images = Vec::with_capacity(images.len());
     let mut pending_views: Vec<(Vec<u8>, usize)> = Vec::new();
     let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string();
+    // Embedded, a core texture's KTX2 image is named the one way glTF allows a KTX2 to be: its
+    // texture reads it through KHR_texture_basisu, and the image says `image/ktx2`.
+    let ktx2: BTreeSet<usize> = match glb || opts.embed {
+        true => core_sources(&json).into_iter().filter(|&i| is_ktx2(scene, i)).collect(),
+        false => BTreeSet::new(),
+    };
+    crate::scene::basisu::core_ktx2_to_basisu(&mut json, &ktx2);
     let core = core_sources(&json);
     for (i, img) in images.iter().enumerate() {
         let mut img = img.clone();
@@ -123,6 +130,7 @@ pub fn write<'a>(scene: &'a Scene, out: &Path, opts: &WriteOptions) -> Result<(O
                 let mime = img
                     .get("mimeType")
                     .and_then(|m| m.as_str())
+                    .filter(|_| !ktx2.contains(&i))
                     .map(|s| s.to_string())
                     .unwrap_or_else(|| sniff_mime(&bytes, u.as_deref().unwrap_or("")));
                 let o = img.as_object_mut().ok_or_else(|| scene.err(format!("image {i} is not an object")))?;
@@ -369,6 +377,11 @@ fn core_mime(scene: &Scene, i: usize) -> bool {
         Ok(b) => b.starts_with(b"\x89PNG") || b.starts_with(&[0xFF, 0xD8]),
         Err(_) => true,
     }
+}
+
+/// Whether image `i` is a KTX2 (by its bytes; one that cannot be read is not).
+fn is_ktx2(scene: &Scene, i: usize) -> bool {
+    scene.image_bytes(i).is_ok_and(|b| b.starts_with(&[0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB]))
 }
 
 fn sniff_mime(bytes: &[u8], uri: &str) -> String {

@@ -30,6 +30,7 @@ pub(in crate::format) fn empty_scene(
         material_cache: Default::default(),
         absent_buffers: Default::default(),
         own_images: true,
+        decoded_steps: Default::default(),
     }
 }
 
