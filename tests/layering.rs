@@ -149,18 +149,23 @@ fn clap_is_only_in_the_command_line() {
     assert!(offenders.is_empty(), "clap outside src/cli and src/main.rs: {offenders:?}");
 }
 
-/// What the library returns is printed by `cli/print` and `cli/bench`, never by the library.
-#[test]
-fn the_library_prints_no_text_tables_or_plots() {
-    let words = ["println!", "print!", "eprintln!", "eprint!", "stdout()", "stderr()", "<svg"];
-    let offenders: Vec<(String, &str)> = checked_files()
+/// Library files (outside the binary) whose code holds any of `words`, with the word.
+fn library_files_using(words: &[&'static str]) -> Vec<(String, &'static str)> {
+    checked_files()
         .into_iter()
         .filter(|f| !in_binary(f))
         .flat_map(|f| {
             let c = code(&f);
             words.iter().filter(|w| c.contains(*w)).map(|w| (f.clone(), *w)).collect::<Vec<_>>()
         })
-        .collect();
+        .collect()
+}
+
+/// What the library returns is printed by `cli/print` and `cli/bench`, never by the library.
+#[test]
+fn the_library_prints_no_text_tables_or_plots() {
+    let offenders =
+        library_files_using(&["println!", "print!", "eprintln!", "eprint!", "stdout()", "stderr()", "<svg"]);
     assert!(offenders.is_empty(), "printing in the library: {offenders:?}");
 }
 
@@ -168,15 +173,8 @@ fn the_library_prints_no_text_tables_or_plots() {
 /// caller from Python or Blender sees every switch. The command line may read the environment.
 #[test]
 fn the_library_reads_no_environment() {
-    let words = ["env::var", "env::vars", "env::args", "var_os(", "option_env!", "env::current_dir"];
-    let offenders: Vec<(String, &str)> = checked_files()
-        .into_iter()
-        .filter(|f| !in_binary(f))
-        .flat_map(|f| {
-            let c = code(&f);
-            words.iter().filter(|w| c.contains(*w)).map(|w| (f.clone(), *w)).collect::<Vec<_>>()
-        })
-        .collect();
+    let offenders =
+        library_files_using(&["env::var", "env::vars", "env::args", "var_os(", "option_env!", "env::current_dir"]);
     assert!(offenders.is_empty(), "environment reads in the library: {offenders:?}");
 }
 

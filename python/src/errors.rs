@@ -10,30 +10,8 @@ pub struct Keywords;
 
 impl Wording for Keywords {
     fn name(&self, s: Setting) -> String {
-        // Every setting by hand, so that a new one fails to build here until it has a keyword.
-        match s {
-            Setting::Convention => "convention",
-            Setting::Material => "material",
-            Setting::MaxPixels => "max_pixels",
-            Setting::AllowOutside => "allow_outside",
-            Setting::Bitangents => "bitangents",
-            Setting::Overwrite => "overwrite",
-            Setting::All => "all",
-            Setting::Ssaa => "ssaa",
-            Setting::Size => "size",
-            Setting::Samples => "samples",
-            Setting::RayFront => "ray_front",
-            Setting::RayBack => "ray_back",
-            Setting::Node => "node",
-            Setting::Bits => "bits",
-            Setting::Alpha => "alpha",
-            Setting::Channel => "channel",
-            Setting::Strength => "strength",
-            Setting::Height => "height",
-            Setting::Normal => "normal",
-            Setting::High => "high",
-        }
-        .to_string()
+        // The library's own names are the command line's field names, which are the keywords.
+        s.name().to_string()
     }
 
     fn given(&self, s: Setting, value: &str) -> String {
