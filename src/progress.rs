@@ -1,5 +1,5 @@
 //! Progress of long work, reported through a caller's [`Progress`]. The library never draws:
-//! the command line turns these calls into bars (`cli/progress.rs`), on a terminal only.
+//! the command line turns these calls into bars (`cli/progress_bars.rs`), on a terminal only.
 //!
 //! Work comes in stages (`read spot.obj`, `bake --from`, `files`), each with a total in one unit
 //! (bytes, rows, files) and ticks as parts of it finish, from any thread.
