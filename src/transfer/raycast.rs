@@ -18,6 +18,8 @@ pub struct Ray {
     /// The origin's coordinates in the order `k` (x, y, then the dominant axis).
     o: [f32; 3],
     shear: [f32; 3],
+    /// Whether only triangles whose front faces the ray's far end (`origin + dir`) are hit.
+    front_only: bool,
 }
 
 impl Ray {
@@ -37,7 +39,15 @@ impl Ray {
         }
         let shear = [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]];
         let o = [origin[kx], origin[ky], origin[kz]];
-        Ray { origin, dir, inv: dir.recip(), k: [kx, ky, kz], o, shear }
+        Ray { origin, dir, inv: dir.recip(), k: [kx, ky, kz], o, shear, front_only: false }
+    }
+
+    /// The ray, hitting only triangles whose front (the side their corners wind
+    /// counter-clockwise seen from, as glTF and OBJ wind them) faces the way `dir` points from,
+    /// that is, towards `origin + dir`: as if the ray came from beyond that end, whichever side
+    /// of the origin the hit lies on.
+    pub fn front_faces_only(self) -> Ray {
+        Ray { front_only: true, ..self }
     }
 }
 
@@ -63,7 +73,7 @@ impl Hit {
     }
 }
 
-/// The watertight test; hits from both sides count.
+/// The watertight test; hits from both sides count, unless the ray takes front faces only.
 ///
 /// Corners are read by axis straight from `v` (`v[i][k]` is one load): a vector register indexed
 /// by a run-time axis goes through memory, and that store and reload cost more than the test.
@@ -93,6 +103,12 @@ pub fn intersect(ray: &Ray, v: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
     }
     let det = u + v + w;
     if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    // The sheared frame keeps handedness (the ray's `k` swaps two axes when `dir` points down
+    // its dominant one), so the sign of the edge functions' sum says which side the ray meets:
+    // negative, the front of a counter-clockwise triangle facing `origin + dir`.
+    if ray.front_only && det > 0.0 {
         return None;
     }
     let t = (u * sz * az + v * sz * bz + w * sz * cz) / det;
@@ -297,6 +313,33 @@ mod tests {
             // Aimed at the edge point (s, 1 - s, 0), from one unit back along the ray.
             let r = Ray::new(Vec3A::new(s, 1.0 - s, 0.0) - d, d);
             assert!(intersect(&r, &a).is_some() || intersect(&r, &b).is_some(), "slipped through at {s}");
+        }
+    }
+
+    /// A counter-clockwise triangle faces the way its normal points: taken with front faces
+    /// only, a ray meets it when its front faces the ray's far end, along every axis, either
+    /// way, and whichever side of the origin it lies on.
+    #[test]
+    fn front_faces_only_keeps_the_triangles_facing_the_far_end() {
+        let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        for axis in 0..3 {
+            // The triangle in the plane across `axis`, its normal along `+axis`.
+            let tri = base.map(|p: [f32; 3]| std::array::from_fn(|a| p[(a + 5 - axis) % 3]));
+            let mut nrm = [0.0; 3];
+            nrm[axis] = 1.0;
+            let n = Vec3A::from(nrm);
+            let inside = Vec3A::from(tri[0]).lerp(Vec3A::from(tri[1]), 0.25).lerp(Vec3A::from(tri[2]), 0.25);
+            for dir in
+                [n, -n, (n + Vec3A::new(0.1, 0.2, 0.3)).normalize(), (-n + Vec3A::new(0.2, 0.1, 0.3)).normalize()]
+            {
+                let faces_far_end = n.dot(dir) > 0.0;
+                for side in [1.0f32, -1.0] {
+                    let r = Ray::new(inside - dir * side, dir);
+                    assert!(intersect(&r, &tri).is_some());
+                    let got = intersect(&r.front_faces_only(), &tri).is_some();
+                    assert_eq!(got, faces_far_end, "axis {axis}, dir {dir}, hit at t = {side}");
+                }
+            }
         }
     }
 
