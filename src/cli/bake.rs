@@ -68,6 +68,14 @@ pub struct Args {
     /// `_lo`/`_hi`, any case, before a `.001` number), or let every part see all of HIGH.
     #[arg(long = "match", value_enum, default_value_t = MatchArg::from(Match::default()), requires = "from")]
     pub matching: MatchArg,
+    /// With --from: dither the 8-bit map (triangular noise of one level, from a hash of the
+    /// texel's position: the same bytes on every run) so gentle gradients do not band.
+    #[arg(long, requires = "from")]
+    pub dither: bool,
+    /// With --from: hit HIGH triangles from their front only (counter-clockwise), as rays cast
+    /// from the cage towards LOW see them: a thin part's inner wall, facing LOW, is passed through.
+    #[arg(long, requires = "from")]
+    pub ignore_backfaces: bool,
     /// With --from: the node to bake a LOW mesh through when several nodes show it.
     #[arg(long, requires = "from")]
     pub node: Option<String>,
@@ -192,6 +200,8 @@ fn transfer_settings(a: &Args) -> Result<Option<Settings>> {
         height,
         padding: a.padding,
         sixteen_bit: a.bits16,
+        dither: a.dither,
+        ignore_backfaces: a.ignore_backfaces,
         map_out: a.map_out.clone(),
         convention: a.convention.map(Into::into).unwrap_or_default(),
         height_out: a.height_out.clone(),

@@ -2,7 +2,7 @@
 //! miss mask, one set per material, named after it when there are several.
 
 use super::tracer::Texel;
-use super::Settings;
+use super::{dither, Settings};
 use crate::error::{Error, Result};
 use crate::normalmap::{self, Convention, Depth, NormalData, NormalImage, PngSettings};
 use crate::scene::Scene;
@@ -54,6 +54,17 @@ pub(super) fn encode(
         let ny = |v: f32| if dx { -v } else { v };
         let data = match depth {
             // On every core: a 2048² map is 4M texels.
+            Depth::Bits8 if s.dither => NormalData::U8(
+                n.par_iter()
+                    .enumerate()
+                    .map(|(i, v)| {
+                        let (x, y) = ((i % w) as u32, (i / w) as u32);
+                        let c = [v[0], ny(v[1]), v[2]];
+                        [0, 1, 2].map(|k| dither::quantize8(c[k], dither::noise(x, y, k as u32)))
+                    })
+                    .collect::<Vec<_>>()
+                    .into_flattened(),
+            ),
             Depth::Bits8 => NormalData::U8(
                 n.par_iter()
                     .map(|v| [v[0], ny(v[1]), v[2]].map(normalmap::quantize8))

@@ -9,6 +9,7 @@
 //! to HIGH's normal exactly, up to the encoding's rounding. Islands are padded ([`pad`]).
 
 pub mod bvh;
+pub mod dither;
 pub mod files;
 pub mod high;
 pub mod mesh;
@@ -53,6 +54,14 @@ pub struct Settings {
     pub height: usize,
     pub padding: usize,
     pub sixteen_bit: bool,
+    /// 8-bit maps get the deterministic triangular dither of [`dither`] before rounding, so a
+    /// gentle gradient does not band (16-bit and float maps are never dithered).
+    pub dither: bool,
+    /// HIGH triangles are hit only from their front (counter-clockwise corners, as glTF and OBJ
+    /// wind them), as if every ray came from beyond its outer end (the cage, or the reach
+    /// outside LOW) towards LOW: a triangle facing into LOW is passed through, whichever side
+    /// of LOW it lies on.
+    pub ignore_backfaces: bool,
     /// Also write the map to this file (PNG, TIFF or EXR), in `convention`.
     pub map_out: Option<PathBuf>,
     pub convention: Convention,
@@ -79,6 +88,8 @@ impl Default for Settings {
             height: 1024,
             padding: 16,
             sixteen_bit: false,
+            dither: false,
+            ignore_backfaces: false,
             map_out: None,
             convention: Convention::Opengl,
             height_out: None,
@@ -194,6 +205,7 @@ pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<Hig
             normals: &normals,
             front,
             back,
+            front_faces_only: s.ignore_backfaces,
         };
         let (texels, mut c, mut part_stats) = t.time("rays", || tracer.trace(s));
         crate::timings::mem_mark("transfer rays");

@@ -18,6 +18,8 @@ pub struct Ray {
     /// The origin's coordinates in the order `k` (x, y, then the dominant axis).
     o: [f32; 3],
     shear: [f32; 3],
+    /// Whether only triangles whose front faces the ray's far end (`origin + dir`) are hit.
+    front_only: bool,
 }
 
 impl Ray {
@@ -37,7 +39,15 @@ impl Ray {
         }
         let shear = [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]];
         let o = [origin[kx], origin[ky], origin[kz]];
-        Ray { origin, dir, inv: dir.recip(), k: [kx, ky, kz], o, shear }
+        Ray { origin, dir, inv: dir.recip(), k: [kx, ky, kz], o, shear, front_only: false }
+    }
+
+    /// The ray, hitting only triangles whose front (the side their corners wind
+    /// counter-clockwise seen from, as glTF and OBJ wind them) faces the way `dir` points from,
+    /// that is, towards `origin + dir`: as if the ray came from beyond that end, whichever side
+    /// of the origin the hit lies on.
+    pub fn front_faces_only(self) -> Ray {
+        Ray { front_only: true, ..self }
     }
 }
 
@@ -63,7 +73,7 @@ impl Hit {
     }
 }
 
-/// The watertight test; hits from both sides count.
+/// The watertight test; hits from both sides count, unless the ray takes front faces only.
 ///
 /// Corners are read by axis straight from `v` (`v[i][k]` is one load): a vector register indexed
 /// by a run-time axis goes through memory, and that store and reload cost more than the test.
@@ -95,6 +105,12 @@ pub fn intersect(ray: &Ray, v: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
     if det == 0.0 || !det.is_finite() {
         return None;
     }
+    // The sheared frame keeps handedness (the ray's `k` swaps two axes when `dir` points down
+    // its dominant one), so the sign of the edge functions' sum says which side the ray meets:
+    // negative, the front of a counter-clockwise triangle facing `origin + dir`.
+    if ray.front_only && det > 0.0 {
+        return None;
+    }
     let t = (u * sz * az + v * sz * bz + w * sz * cz) / det;
     let inv = 1.0 / det;
     Some((t, [u * inv, v * inv, w * inv]))
@@ -120,10 +136,10 @@ pub struct Stack(Vec<Todo>);
 /// visited nearest first. A child is dropped only once its part of the ray lies farther from the
 /// origin than the best hit; which hit wins never depends on the order: see `Hit::better_than`.
 ///
-/// Known limits (`tests/nearest.rs`): the slab test has no rounding margin, so a hit on a box's
-/// boundary can be skipped by an ulp (a tie may then go to a higher index, or a ray through a
-/// box's corner miss it); and a ray with no part along an axis, lying in a box's lower face in
-/// that axis, misses the box (`0 * inf` is NaN there and the lane's bounds come out `+inf`).
+/// The box test is watertight, so the tree finds what a test of every triangle finds
+/// (`tests/nearest.rs`): each box's part of the ray is widened by a rounding margin (see
+/// [`BOX_MARGIN`]), and an axis the ray has no part of is tested by where the origin lies, not
+/// by `0 * inf`, which is NaN for a ray lying in a box's face.
 pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -> Option<Hit> {
     if bvh.is_empty() {
         return None;
@@ -132,12 +148,16 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -
     let (mut lo, mut hi) = (-back, front);
     let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
     let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
+    // A component so small that its reciprocal overflows counts as none: the ray then stays in
+    // the slab it starts in (or out of it) however far it goes.
+    let flat = ray.inv.to_array().map(|x| x.is_infinite());
+    let boxes = Boxes { o, inv, flat };
     let nothing = Todo { child: 0, count: 0, gap: 0.0 };
     let stack = &mut stack.0;
     stack.clear();
     let mut todo = nothing;
     loop {
-        if let Some(next) = visit(bvh, ray, todo, &o, &inv, &mut lo, &mut hi, &mut best, stack) {
+        if let Some(next) = visit(bvh, ray, todo, &boxes, &mut lo, &mut hi, &mut best, stack) {
             todo = next;
             continue;
         }
@@ -152,6 +172,28 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -
     }
 }
 
+/// How much each box's part of the ray is widened, relative to its ends' distances: PBRT's
+/// `2 * gamma(3)` (Pharr, Jakob and Humphreys, *Physically Based Rendering*, 4th ed., 6.8.2).
+/// A slab distance `(bound - origin) * (1 / dir)` is three roundings from the exact one, each
+/// within a relative `eps`, so the computed entry and exit lie within `gamma(3)` of their exact
+/// values: entry moved towards the origin and exit away from it by twice that, a hit on a box's
+/// face, edge or corner is never outside its box's part of the ray.
+pub const BOX_MARGIN: f32 = 2.0 * gamma(3);
+
+/// PBRT's bound on `n` roundings' relative error, `n * eps / (1 - n * eps)`, `eps` half an ulp.
+const fn gamma(n: u32) -> f32 {
+    let e = f32::EPSILON * 0.5 * n as f32;
+    e / (1.0 - e)
+}
+
+/// What every box test of one ray shares: its origin and reciprocal direction, one lane per
+/// child, and which axes it has no part of.
+struct Boxes {
+    o: [Vec4; 3],
+    inv: [Vec4; 3],
+    flat: [bool; 3],
+}
+
 /// Tests a leaf's triangles, or a four-wide node's boxes: the children hit are pushed, farthest
 /// first, except the nearest, which is returned to be visited next.
 #[allow(clippy::too_many_arguments)]
@@ -160,8 +202,7 @@ fn visit(
     bvh: &Bvh,
     ray: &Ray,
     todo: Todo,
-    o: &[Vec4; 3],
-    inv: &[Vec4; 3],
+    boxes: &Boxes,
     lo: &mut f32,
     hi: &mut f32,
     best: &mut Option<Hit>,
@@ -185,17 +226,26 @@ fn visit(
         return None;
     }
     let n = &bvh.nodes[todo.child as usize];
-    // The operand order of these `min`s and `max`s is part of the result: `_mm_min_ps` and
-    // `_mm_max_ps` return their second operand when either is NaN (`0 * inf`, a ray parallel to
-    // a slab starting on its face).
+    let Boxes { o, inv, flat } = boxes;
     let slab = |a: usize| {
+        if flat[a] {
+            // Faces included: a ray lying in a face is in the box. Outside, an empty part whose
+            // ends stay finite through the margin below.
+            let inside = n.min[a].cmple(o[a]) & n.max[a].cmpge(o[a]);
+            let (full, none) = (Vec4::splat(f32::INFINITY), Vec4::splat(f32::MAX));
+            return (Vec4::select(inside, -full, none), Vec4::select(inside, full, -none));
+        }
         let t0 = (n.min[a] - o[a]) * inv[a];
         let t1 = (n.max[a] - o[a]) * inv[a];
         (t0.min(t1), t0.max(t1))
     };
     let ((ax, bx), (ay, by), (az, bz)) = (slab(0), slab(1), slab(2));
-    let near = ax.max(az).max(ay.max(az)).max(Vec4::splat(*lo));
-    let far = bx.min(bz).min(by.min(bz)).min(Vec4::splat(*hi));
+    // Widened by scaling, not by adding a multiple of the magnitude, so that an infinite end
+    // stays infinite instead of becoming `inf - inf`.
+    let m = Vec4::splat(BOX_MARGIN);
+    let (near, far) = (ax.max(ay).max(az), bx.min(by).min(bz));
+    let near = (near * (Vec4::ONE - m.copysign(near))).max(Vec4::splat(*lo));
+    let far = (far * (Vec4::ONE + m.copysign(far))).min(Vec4::splat(*hi));
     let mut mask = near.cmple(far).bitmask() & n.lanes;
     if mask == 0 {
         return None;
@@ -263,6 +313,33 @@ mod tests {
             // Aimed at the edge point (s, 1 - s, 0), from one unit back along the ray.
             let r = Ray::new(Vec3A::new(s, 1.0 - s, 0.0) - d, d);
             assert!(intersect(&r, &a).is_some() || intersect(&r, &b).is_some(), "slipped through at {s}");
+        }
+    }
+
+    /// A counter-clockwise triangle faces the way its normal points: taken with front faces
+    /// only, a ray meets it when its front faces the ray's far end, along every axis, either
+    /// way, and whichever side of the origin it lies on.
+    #[test]
+    fn front_faces_only_keeps_the_triangles_facing_the_far_end() {
+        let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        for axis in 0..3 {
+            // The triangle in the plane across `axis`, its normal along `+axis`.
+            let tri = base.map(|p: [f32; 3]| std::array::from_fn(|a| p[(a + 5 - axis) % 3]));
+            let mut nrm = [0.0; 3];
+            nrm[axis] = 1.0;
+            let n = Vec3A::from(nrm);
+            let inside = Vec3A::from(tri[0]).lerp(Vec3A::from(tri[1]), 0.25).lerp(Vec3A::from(tri[2]), 0.25);
+            for dir in
+                [n, -n, (n + Vec3A::new(0.1, 0.2, 0.3)).normalize(), (-n + Vec3A::new(0.2, 0.1, 0.3)).normalize()]
+            {
+                let faces_far_end = n.dot(dir) > 0.0;
+                for side in [1.0f32, -1.0] {
+                    let r = Ray::new(inside - dir * side, dir);
+                    assert!(intersect(&r, &tri).is_some());
+                    let got = intersect(&r.front_faces_only(), &tri).is_some();
+                    assert_eq!(got, faces_far_end, "axis {axis}, dir {dir}, hit at t = {side}");
+                }
+            }
         }
     }
 

@@ -48,6 +48,8 @@ pub(super) struct Tracer<'a> {
     pub(super) normals: &'a [[f32; 3]],
     pub(super) front: f64,
     pub(super) back: f64,
+    /// Whether HIGH is hit from its front only ([`raycast::Ray::front_faces_only`]).
+    pub(super) front_faces_only: bool,
 }
 
 /// What one ray gave: the tangent-space normal and the signed distance to HIGH, if it hit.
@@ -221,7 +223,11 @@ impl Tracer<'_> {
         };
         let set = self.low_set[low.tri_part[t] as usize];
         let tree = &self.trees[set];
-        let Some(hit) = raycast::nearest(tree, &raycast::Ray::new(p, dir), back, front, stack) else {
+        let mut ray = raycast::Ray::new(p, dir);
+        if self.front_faces_only {
+            ray = ray.front_faces_only();
+        }
+        let Some(hit) = raycast::nearest(tree, &ray, back, front, stack) else {
             c.missed_rays += 1;
             return flat;
         };
