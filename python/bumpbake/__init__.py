@@ -358,7 +358,7 @@ def validate(path: PathLike, **options: Any) -> dict[str, Any]:
     ``warnings`` counts, each finding with its code); they do not raise. Options: ``strict``,
     ``deny``/``allow`` (lists of codes), ``max_angle_deg``, ``image_convention``,
     ``allow_outside``."""
-    return _run("validate", "validate", ["--format=json"], [path], options, None)
+    return _run("validate", "validate", ["--format=json", "--quiet"], [path], options, None)
 
 
 def tangents_file(

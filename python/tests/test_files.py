@@ -168,3 +168,12 @@ def test_notes_in_the_dicts_name_keywords(tmp_path, fixtures):
     # The command line words the same note with its flag.
     want = cli_json("tangents", mirror, "-o", tmp_path / "c.glb", "--json")
     assert "--overwrite" in want["primitives"][0]["reason"]
+
+
+def test_file_calls_print_nothing(tmp_path, fixtures, capfd):
+    mirror = fixtures / "khronos/NormalTangentMirrorTest.glb"
+    bumpbake.validate(mirror)
+    bumpbake.inspect(mirror)
+    bumpbake.tangents_file(mirror, tmp_path / "m.glb", overwrite=True)
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
