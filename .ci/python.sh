@@ -10,20 +10,7 @@ work="$target/python-ci"
 rm -rf "$work" && mkdir -p "$work"
 pins="$PWD/python/requirements-ci.txt"
 
-# CPython X.Y: on PATH when it runs, else pyenv's newest X.Y.* (its shims answer only for the
-# versions pyenv is set to).
-python_of() {
-  if "python$1" -c '' 2>/dev/null; then
-    command -v "python$1"
-    return
-  fi
-  local found
-  found=$(ls -d "$(pyenv root 2>/dev/null)/versions/$1".* 2>/dev/null | sort -V | tail -n 1)
-  [ -n "$found" ] || { echo "CPython $1 is not installed" >&2; return 1; }
-  echo "$found/bin/python$1"
-}
-
-"$(python_of 3.11)" -m venv "$work/build"
+"$(bash .ci/python-of.sh 3.11)" -m venv "$work/build"
 "$work/build/bin/pip" install --quiet --disable-pip-version-check -r "$pins"
 "$work/build/bin/ruff" check python
 "$work/build/bin/ruff" format --check python
@@ -39,7 +26,7 @@ for tool in sh env uname; do ln -sf "$(command -v "$tool")" "$plain/$tool"; done
 
 for version in 3.11 3.12; do
   venv="$work/venv-$version"
-  "$(python_of "$version")" -m venv "$venv"
+  "$(bash .ci/python-of.sh "$version")" -m venv "$venv"
   "$venv/bin/pip" install --quiet --disable-pip-version-check "$wheel" "$(grep '^numpy' "$pins")" "$(grep '^pytest' "$pins")"
   echo "== CPython $version: the wheel with no toolchain on PATH"
   env -i HOME="$HOME" PATH="$venv/bin:$plain" sh -c '
