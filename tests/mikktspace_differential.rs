@@ -443,7 +443,7 @@ fn soak() {
 #[test]
 #[ignore]
 fn write_obj_references() {
-    use bumpbake::scene::{ReadOptions, Scene};
+    use bumpbake::scene::ReadOptions;
     use std::fmt::Write;
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
     for (obj, out) in

@@ -15,7 +15,7 @@
 //! - [`pbr`]: glTF's metallic-roughness BRDF (`Shading::Pbr`).
 //! - [`views`]: the debug views.
 //! - [`compare`]: pipeline error between two renders.
-//! - [`file`]: the `preview` command file to file ([`render_file`], [`compare_files`]) and its
+//! - [`file`](mod@file): the `preview` command file to file ([`render_file`], [`compare_files`]) and its
 //!   reports.
 
 pub mod camera;

@@ -1,7 +1,7 @@
 //! What the OBJ and PLY readers share: the mesh as either file stores it ([`StoredMesh`]: values
 //! in the file's own conventions, UVs v up, each attribute with its own index stream or, as PLY
-//! stores them, one value per position), the numbers of their text ([`text_number`]) and the
-//! corners made a glTF primitive ([`to_gltf`]). The Scene builders (`obj/`, `ply/scene.rs`) and
+//! stores them, one value per position), the numbers of their text (`text_number.rs`) and the
+//! corners made a glTF primitive (`to_gltf.rs`). The Scene builders (`obj/`, `ply/scene.rs`) and
 //! HIGH's reader (`transfer/high.rs`) take a `StoredMesh` from there, and turn v down through
 //! [`v_down`], the one flip.
 
