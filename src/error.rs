@@ -52,6 +52,8 @@ pub enum Setting {
     Channel,
     /// How strongly heights tilt the normals.
     Strength,
+    /// The surface height of a height map's `h = 1`, in the mesh's (or metres') units.
+    HeightRange,
     /// A height map to bake into a normal map.
     Height,
     /// A normal map to bake.
@@ -63,7 +65,7 @@ pub enum Setting {
 impl Setting {
     /// Every setting, in declaration order (a new variant goes here too: the front ends' tests
     /// check each has a name).
-    pub const EVERY: [Setting; 20] = [
+    pub const EVERY: [Setting; 21] = [
         Setting::Convention,
         Setting::Material,
         Setting::MaxPixels,
@@ -81,6 +83,7 @@ impl Setting {
         Setting::Alpha,
         Setting::Channel,
         Setting::Strength,
+        Setting::HeightRange,
         Setting::Height,
         Setting::Normal,
         Setting::High,
@@ -106,6 +109,7 @@ impl Setting {
             Setting::Alpha => "alpha",
             Setting::Channel => "channel",
             Setting::Strength => "strength",
+            Setting::HeightRange => "height_range",
             Setting::Height => "height",
             Setting::Normal => "normal",
             Setting::High => "high",

@@ -2,7 +2,8 @@
 
 The engine of the ``bumpbake`` command line, on NumPy arrays and on files:
 
-- :func:`tangents` and :func:`normalmap` work on arrays (a DCC's mesh, a height field);
+- :func:`tangents`, :func:`normalmap` and :func:`bump_to_normal` work on arrays (a DCC's mesh,
+  a height field, a height field through a mesh);
 - :func:`inspect`, :func:`validate`, :func:`tangents_file`, :func:`bake`, :func:`bake_from` and
   :func:`textures` work on files and return the JSON the command line prints, as dicts;
 - ``python -m bumpbake`` and the ``bumpbake`` console script are the command line itself.
@@ -37,6 +38,7 @@ __all__ = [
     "__version__",
     "bake",
     "bake_from",
+    "bump_to_normal",
     "inspect",
     "normalmap",
     "tangents",
@@ -165,6 +167,9 @@ def tangents(
     return (out_t, out_b) if out_b is not None else out_t
 
 
+_mikktspace = tangents
+
+
 def _height(a: Any) -> tuple[np.ndarray, str]:
     arr = np.asarray(a)
     if arr.ndim == 3 and arr.shape[2] == 1:
@@ -265,6 +270,109 @@ def normalmap(
             _addr(out),
             bool(report),
             progress,
+        )
+    )
+    return (out, info) if report else out
+
+
+def bump_to_normal(
+    height: Any,
+    positions: Any,
+    normals: Any,
+    uvs: Any,
+    indices: Any = None,
+    tangents: Any = None,
+    *,
+    distance: float,
+    strength: float = 1.0,
+    invert: bool = False,
+    uv_origin: str = "top-left",
+    convention: str = "opengl",
+    filter: str = "central",
+    wrap: str = "repeat",
+    padding: int = 16,
+    bits: int = 8,
+    report: bool = False,
+) -> np.ndarray | tuple[np.ndarray, dict[str, Any]]:
+    """The tangent-space normal map of a height map through a mesh: drawn with the mesh's
+    MikkTSpace frames, it shades as Blender's (Cycles') Bump node shades the mesh with that height.
+
+    Each texel's height slope is taken on the surface, with the texel's world-space extent along
+    the tangent and bitangent from the mesh's UV layout, so stretched UVs, curved meshes and
+    scaled objects come out right (``normalmap`` assumes one texel size for the whole map).
+
+    Args:
+        height: (rows, columns) heights, row 0 at the top of the image (as :func:`normalmap`).
+        positions, normals, uvs: (N, 3), (N, 3), (N, 2) per vertex, in world space (the object's
+            transform applied) and the UV set the map is laid out in.
+        indices: (T*3,) or (T, 3) triangle corners; None: every three rows are a triangle.
+        tangents: (N, 4) tangents ``(x, y, z, w)`` a renderer draws the map with (Blender's
+            ``calc_tangents``); None: bumpbake's MikkTSpace of the mesh, as :func:`tangents`.
+        distance, strength, invert: the Bump node's Distance (mesh units for a height of 1),
+            Strength (the bumped normal mixed with the unbumped one) and Invert.
+        uv_origin: ``"top-left"`` (glTF) or ``"bottom-left"`` (Blender, OpenGL).
+        convention: ``"opengl"`` (+Y up: glTF, Blender) or ``"directx"``.
+        filter, wrap: the height's derivative filter and what lies beyond its edges.
+        padding: rings of texels around the UV islands filled from the island's edge.
+        bits: 8, 16 (encoded as an image stores them) or 32 (float32 unit vectors).
+        report: also return a dict: coverage of the map by the mesh and ``engine_ms``.
+
+    Returns:
+        (rows, columns, 3) array; with ``report``, ``(map, report_dict)``.
+    """
+    _choice("uv_origin", uv_origin, UV_ORIGINS)
+    _choice("convention", convention, CONVENTIONS)
+    _choice("filter", filter, FILTERS)
+    _choice("wrap", wrap, WRAPS)
+    if bits not in (8, 16, 32) or isinstance(bits, bool):
+        raise UsageError(f"bits={bits!r}: use 8, 16 or 32")
+    for name, v in (("distance", distance), ("strength", strength)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
+            raise UsageError(f"{name}={v!r}: must be a finite number")
+    if isinstance(padding, bool) or not isinstance(padding, int) or padding < 0:
+        raise UsageError(f"padding={padding!r}: must be a whole number of texels, 0 or more")
+    arr, kind = _height(height)
+    pos = _rows("positions", positions, 3)
+    n = len(pos)
+    nor = _rows("normals", normals, 3)
+    uv = _rows("uvs", uvs, 2)
+    tan = None if tangents is None else _rows("tangents", tangents, 4)
+    for name, a in (("normals", nor), ("uvs", uv), ("tangents", tan)):
+        if a is not None and len(a) != n:
+            raise InputError(f"{name} has {len(a)} rows but positions has {n}")
+    if indices is None and n % 3:
+        raise InputError(f"{n} vertices and no indices: a triangle list has three corners per triangle")
+    idx = np.arange(n, dtype=np.uint32) if indices is None else _indices(indices, n)
+    if tan is None:
+        tan = _mikktspace(pos, nor, uv, idx, uv_origin=uv_origin, corners=True)
+    else:
+        tan = tan[idx]
+    pos, nor, uv = pos[idx], nor[idx], uv[idx]
+    if uv_origin == "bottom-left":
+        uv = np.ascontiguousarray(np.stack([uv[:, 0], 1.0 - uv[:, 1]], axis=1), dtype=np.float32)
+    tan = np.require(tan, dtype=np.float32, requirements=["C", "A"])
+    rows, cols = arr.shape
+    out = np.empty((rows, cols, 3), dtype={8: np.uint8, 16: np.uint16, 32: np.float32}[bits])
+    info = json.loads(
+        _native.bump_to_normal(
+            _addr(arr),
+            kind,
+            cols,
+            rows,
+            len(idx),
+            _addr(pos),
+            _addr(nor),
+            _addr(tan),
+            _addr(uv),
+            float(distance),
+            float(strength),
+            bool(invert),
+            filter,
+            wrap,
+            padding,
+            convention,
+            bits,
+            _addr(out),
         )
     )
     return (out, info) if report else out

@@ -33,6 +33,26 @@ def normalmap(
     report: bool,
     progress: Callable[[str, int, int, str], Any] | None = None,
 ) -> str: ...
+def bump_to_normal(
+    height: int,
+    dtype: str,
+    width: int,
+    rows: int,
+    corners: int,
+    positions: int,
+    normals: int,
+    tangents: int,
+    uvs: int,
+    distance: float,
+    strength: float,
+    invert: bool,
+    filter: str,
+    wrap: str,
+    padding: int,
+    convention: str,
+    bits: int,
+    out: int,
+) -> str: ...
 def run(argv: list[str], progress: Callable[[str, int, int, str], Any] | None = None) -> tuple[int, str]: ...
 def main(argv: list[str]) -> int: ...
 def options(command: str) -> list[tuple[str, str | None, bool, bool]]: ...

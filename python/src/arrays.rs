@@ -283,3 +283,103 @@ pub fn normalmap(
     });
     Ok(report.to_string())
 }
+
+/// The normal map of a height array through a mesh, as Cycles' Bump node shades it
+/// ([`bumpbake::bake::surface`]), into `out` (`rows` x `width` x 3 of uint8, uint16 or float32
+/// for `bits` 8, 16, 32). The mesh is a triangle list of `corners` corners, one row per corner
+/// in each array; `uvs` are glTF's (v down). Returns the coverage and `engine_ms` as JSON.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (height, dtype, width, rows, corners, positions, normals, tangents, uvs, distance, strength, invert, filter, wrap, padding, convention, bits, out))]
+pub fn bump_to_normal(
+    py: Python<'_>,
+    height: usize,
+    dtype: &str,
+    width: usize,
+    rows: usize,
+    corners: usize,
+    positions: usize,
+    normals: usize,
+    tangents: usize,
+    uvs: usize,
+    distance: f64,
+    strength: f64,
+    invert: bool,
+    filter: &str,
+    wrap: &str,
+    padding: usize,
+    convention: &str,
+    bits: u32,
+    out: usize,
+) -> PyResult<String> {
+    use bumpbake::bake::surface::{surface_normals, Bump, SurfaceMesh};
+    crate::errors::speak_keywords();
+    let usage = |what: &str, v: &str| raise(py, Kind::Usage, format!("{what}={v:?} is not one of bumpbake's"));
+    let filter = named(&Filter::ALL, filter).ok_or_else(|| usage("filter", filter))?;
+    let wrap = named(&[Wrap::Repeat, Wrap::Clamp, Wrap::Mirror], wrap).ok_or_else(|| usage("wrap", wrap))?;
+    let convention =
+        named(&[Convention::Opengl, Convention::Directx], convention).ok_or_else(|| usage("convention", convention))?;
+    let depth = match bits {
+        8 => Depth::Bits8,
+        16 => Depth::Bits16,
+        32 => Depth::Float,
+        _ => return Err(usage("bits", &bits.to_string())),
+    };
+    let plane = height_plane(height, dtype, width, rows).ok_or_else(|| usage("height.dtype", dtype))?;
+    if let Some(i) = plane.data.iter().position(|v| !v.is_finite()) {
+        let msg =
+            format!("height[{}, {}] is {}: a height map's samples must be finite", i / width, i % width, plane.data[i]);
+        return Err(raise(py, Kind::Input, msg));
+    }
+    // SAFETY: per-corner arrays the Python side checked and holds, `corners` rows each.
+    let (positions, normals, tangents, uvs) = unsafe {
+        (
+            slice::<[f32; 3]>(positions, corners),
+            slice::<[f32; 3]>(normals, corners),
+            slice::<[f32; 4]>(tangents, corners),
+            slice::<[f32; 2]>(uvs, corners),
+        )
+    };
+    let bump = Bump { distance, strength, invert, filter, wrap, padding };
+    let n = width * rows * 3;
+    let (map, engine_ms) = py.detach(|| {
+        let start = std::time::Instant::now();
+        let triangles: Vec<[u32; 3]> = (0..corners as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+        let mesh = SurfaceMesh { positions, normals, tangents, uvs, triangles: &triangles };
+        let map = surface_normals(&mesh, &plane, &bump);
+        let enc = EncodeOptions { depth, convention, alpha_height: false };
+        // SAFETY: `out` is the array the Python side allocated: `n` samples of the depth's type.
+        unsafe {
+            match depth {
+                Depth::Float => {
+                    let out = slice_mut::<f32>(out, n);
+                    for (o, v) in out.chunks_exact_mut(3).zip(&map.normals.data) {
+                        o.copy_from_slice(&[v[0], v[1] * convention.y_sign(), v[2]]);
+                    }
+                }
+                _ => match nm::encode_plane(&map.normals, &enc, None).data {
+                    NormalData::U8(v) => slice_mut::<u8>(out, n).copy_from_slice(&v),
+                    NormalData::U16(v) => slice_mut::<u16>(out, n).copy_from_slice(&v),
+                    NormalData::F32(v) => slice_mut::<f32>(out, n).copy_from_slice(&v),
+                },
+            }
+        }
+        (map, start.elapsed().as_secs_f64() * 1e3)
+    });
+    let report = serde_json::json!({
+        "width": width,
+        "height": rows,
+        "triangles": corners / 3,
+        "distance": distance,
+        "strength": strength,
+        "invert": invert,
+        "filter": filter,
+        "wrap": wrap,
+        "convention": convention,
+        "covered": map.covered,
+        "padded": map.padded,
+        "uncovered": map.uncovered,
+        "engine_ms": engine_ms,
+    });
+    Ok(report.to_string())
+}

@@ -24,6 +24,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(arrays::tangents, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::normalmap, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::bump_to_normal, m)?)?;
     m.add_function(wrap_pyfunction!(commands::run, m)?)?;
     m.add_function(wrap_pyfunction!(commands::main, m)?)?;
     m.add_function(wrap_pyfunction!(commands::options, m)?)?;

@@ -10,6 +10,10 @@ use std::path::Path;
 #[derive(Debug, Clone, Copy)]
 pub struct HeightSettings {
     pub strength: f32,
+    /// The surface height of `h = 1`, in scene units: the map is made through the mesh
+    /// ([`super::surface`]), each texel as large as the mesh lays it out (times `strength` and an
+    /// MTL `-bm`). `None`: `strength` texels per unit of `h`, one size for every texel.
+    pub height_range: Option<f64>,
     pub filter: Filter,
     pub invert: bool,
     pub channel: Channel,
@@ -21,6 +25,7 @@ impl Default for HeightSettings {
     fn default() -> Self {
         HeightSettings {
             strength: 1.0,
+            height_range: None,
             filter: Filter::default(),
             invert: false,
             channel: Channel::Luma,
@@ -56,6 +61,69 @@ pub fn from_height(path: &Path, multiplier: f32, wrap: Wrap, s: &HeightSettings)
     let warning = normalmap::Flatness::of_image(&img)
         .warning(&plane, opts.strength, multiplier)
         .map(|w| format!("{}: {w}", path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()));
+    let png = normalmap::png_bytes(&img, PngSettings::default()).map_err(|e| Error::output(path, e))?;
+    Ok((png, warning))
+}
+
+/// A PNG normal map (glTF convention) of a height map file made through the triangles of
+/// material `m` where the scene places them ([`super::surface`]): what Cycles' Bump node with
+/// Distance `range · strength · multiplier` shows on that mesh. The material's primitives carry
+/// tangents already. Also a warning when it comes out (nearly) flat.
+pub fn through_mesh(
+    scene: &Scene,
+    m: usize,
+    path: &Path,
+    multiplier: f32,
+    range: f64,
+    s: &HeightSettings,
+) -> Result<(Vec<u8>, Option<String>)> {
+    use crate::transfer::mesh;
+    let plane = normalmap::load_height(path, s.channel, s.max_pixels)?;
+    let prims = crate::transfer::material_prims(scene, m);
+    // A mesh shown by several nodes has one map for all of them: made in its own units.
+    let placed = mesh::place(scene, &prims, None).unwrap_or_else(|_| {
+        prims.iter().map(|&prim| mesh::Placed { prim, placement: None, part: String::new() }).collect()
+    });
+    let part = vec![0; placed.len()];
+    let (origin, diagonal) = mesh::frame(scene, &placed)?;
+    let low = mesh::low(scene, &placed, &part, origin, diagonal)?;
+    let v3 = |v: &[glam::Vec3A]| v.iter().map(|p| p.to_array()).collect::<Vec<[f32; 3]>>();
+    let (positions, normals) = (v3(&low.positions), v3(&low.normals));
+    let surface = super::surface::SurfaceMesh {
+        positions: &positions,
+        normals: &normals,
+        tangents: &low.tangents,
+        uvs: &low.uvs,
+        triangles: &low.triangles,
+    };
+    let distance = range * s.strength as f64 * multiplier as f64;
+    let bump = super::surface::Bump {
+        distance,
+        invert: s.invert,
+        filter: s.filter,
+        wrap: material_wrap(scene, m),
+        ..Default::default()
+    };
+    let map = super::surface::surface_normals(&surface, &plane, &bump);
+    let enc = EncodeOptions {
+        depth: if s.sixteen_bit { normalmap::Depth::Bits16 } else { normalmap::Depth::Bits8 },
+        convention: Convention::Opengl,
+        alpha_height: false,
+    };
+    let img = normalmap::encode_plane(&map.normals, &enc, None);
+    let mut tilt = normalmap::Flatness::default();
+    map.normals.data.iter().for_each(|&n| tilt.push(n));
+    let warning = (normalmap::Flatness::of_image(&img).verdict() != normalmap::Verdict::Relief).then(|| {
+        let name = path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default();
+        let deg = tilt.max_tilt_deg();
+        if deg == 0.0 {
+            return format!("{name}: the height map is flat on the mesh, so the normal map changes nothing");
+        }
+        // Small tilts grow in proportion to the distance.
+        let wanted = range * 30f64.to_radians().tan() / deg.to_radians().tan();
+        let w = Words::from(format!("{name}: the normal map is (nearly) flat: its largest tilt is {deg:.2}°; "));
+        w.given(Setting::HeightRange, format!("{wanted:.3e}")).text(" would tilt the steepest slope 30°").to_string()
+    });
     let png = normalmap::png_bytes(&img, PngSettings::default()).map_err(|e| Error::output(path, e))?;
     Ok((png, warning))
 }

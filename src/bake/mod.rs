@@ -3,6 +3,7 @@
 //! whatever the scene does not need is left out ([`Scene::leave_out`]).
 
 pub mod maps;
+pub mod surface;
 
 use crate::error::{Error, Result, Setting, Words};
 use crate::format::{self, WriteOptions, WriteStats};
@@ -90,7 +91,7 @@ pub fn run_from(job: &BakeJob, high: Vec<crate::transfer::high::HighMesh>) -> Re
     let mut deps = scene.dependencies();
     let created = scene.ensure_material();
     let mut warnings = Vec::new();
-    let mut targets = t.time("maps", || attach_maps(&mut scene, job, &mut deps, &mut warnings))?;
+    let (mut targets, through) = t.time("maps", || attach_maps(&mut scene, job, &mut deps, &mut warnings))?;
     for target in targets.iter_mut() {
         target.created = created == Some(target.material);
     }
@@ -104,6 +105,14 @@ pub fn run_from(job: &BakeJob, high: Vec<crate::transfer::high::HighMesh>) -> Re
             },
         )
     })?;
+    if let Some(range) = job.height.height_range {
+        for h in &through {
+            let (png, warning) =
+                t.time("maps", || maps::through_mesh(&scene, h.material, &h.path, h.multiplier, range, &job.height))?;
+            warnings.extend(warning);
+            maps::replace_normal_image(&mut scene, h.material, &png);
+        }
+    }
     let transfer = match &job.map {
         MapSource::Transfer(ts) => {
             deps.extend(ts.highs.iter().chain(ts.cage.iter()).cloned());
@@ -192,13 +201,23 @@ fn material_names(scene: &Scene) -> Vec<Option<String>> {
     scene.materials().list.iter().map(|m| m.name.clone()).collect()
 }
 
-/// Decides which materials get which map, and attaches them.
+/// A height map to make through the mesh once it has tangents ([`maps::through_mesh`]).
+struct ThroughMesh {
+    material: usize,
+    path: PathBuf,
+    multiplier: f32,
+}
+
+/// Decides which materials get which map, and attaches them; height maps made through the mesh
+/// hold a flat map's place until tangents exist, and are returned.
 fn attach_maps(
     scene: &mut Scene,
     job: &BakeJob,
     deps: &mut Vec<PathBuf>,
     warnings: &mut Vec<String>,
-) -> Result<Vec<MaterialMap>> {
+) -> Result<(Vec<MaterialMap>, Vec<ThroughMesh>)> {
+    let mesh_aware = job.height.height_range.is_some();
+    let mut through = Vec::new();
     let names = material_names(scene);
     let chosen: Option<usize> = match &job.material {
         Some(want) => Some(names.iter().position(|n| n.as_deref() == Some(want.as_str())).ok_or_else(|| {
@@ -242,6 +261,21 @@ fn attach_maps(
                 let file = ts.highs.first().cloned();
                 out.push(MaterialMap { material: m, name, created: false, source: "high", file, convention: None });
             }
+            MapSource::Height(p) if mesh_aware => {
+                maps::attach(scene, m, &maps::flat_png(), &label);
+                through.push(ThroughMesh { material: m, path: p.clone(), multiplier: 1.0 });
+                if !deps.contains(p) {
+                    deps.push(p.clone());
+                }
+                out.push(MaterialMap {
+                    material: m,
+                    name,
+                    created: false,
+                    source: "height",
+                    file: Some(p.clone()),
+                    convention: None,
+                });
+            }
             MapSource::Height(p) | MapSource::Normal(p) => {
                 if made.is_none() {
                     made = Some(match &job.map {
@@ -271,10 +305,15 @@ fn attach_maps(
             }
             MapSource::Scene => {
                 if let Some(h) = scene.height_maps.iter().find(|h| h.material == m).cloned() {
-                    let (png, warning) =
-                        maps::from_height(&h.path, h.multiplier, maps::material_wrap(scene, m), &job.height)?;
-                    warnings.extend(warning);
-                    maps::attach(scene, m, &png, &label);
+                    if mesh_aware {
+                        maps::attach(scene, m, &maps::flat_png(), &label);
+                        through.push(ThroughMesh { material: m, path: h.path.clone(), multiplier: h.multiplier });
+                    } else {
+                        let (png, warning) =
+                            maps::from_height(&h.path, h.multiplier, maps::material_wrap(scene, m), &job.height)?;
+                        warnings.extend(warning);
+                        maps::attach(scene, m, &png, &label);
+                    }
                     out.push(MaterialMap {
                         material: m,
                         name,
@@ -300,7 +339,7 @@ fn attach_maps(
         let why = Words::from("no material has a height or normal map: nothing to bake (give ");
         scene.notes.push(why.name(Setting::Height).text(" or ").name(Setting::Normal).text(")").to_string());
     }
-    Ok(out)
+    Ok((out, through))
 }
 
 /// Without `--material`, `--from` bakes every material LOW's triangle primitives use, each into

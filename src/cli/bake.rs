@@ -94,10 +94,13 @@ pub struct Args {
     /// it. An MTL bump map's -bm multiplies it.
     #[arg(long, default_value_t = 1.0, conflicts_with = "height_range")]
     pub strength: f32,
-    /// Physical units: height of h = 1, in metres (with --texel-size).
-    #[arg(long, requires = "texel_size")]
+    /// Height of h = 1 in the scene's units (Blender's Bump Distance). Alone, the map is made
+    /// through the mesh: each texel as large as the mesh lays it out, so stretched UVs, curved
+    /// and scaled meshes shade as Blender's Bump node shades them. With --texel-size, one size
+    /// for every texel.
+    #[arg(long)]
     pub height_range: Option<f32>,
-    /// Physical units: size of one texel, in metres.
+    /// Physical units: size of one texel, in metres (with --height-range).
     #[arg(long, requires = "height_range")]
     pub texel_size: Option<f32>,
     /// Derivative filter for height maps.
@@ -136,10 +139,12 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<u8> {
     let outputs = a.io.outputs(&a.batch.out_dir)?;
-    let strength = match (a.height_range, a.texel_size) {
-        (Some(r), Some(t)) if t > 0.0 && r.is_finite() && t.is_finite() => r / t,
+    let (strength, height_range) = match (a.height_range, a.texel_size) {
+        (Some(r), Some(t)) if t > 0.0 && r.is_finite() && t.is_finite() => (r / t, None),
         (Some(_), Some(_)) => return Err(Error::usage("--texel-size must be a positive number")),
-        _ => a.strength,
+        (Some(r), None) if r.is_finite() => (1.0, Some(r as f64)),
+        (Some(_), None) => return Err(Error::usage("--height-range must be finite")),
+        _ => (a.strength, None),
     };
     if !strength.is_finite() {
         return Err(Error::usage("--strength must be finite"));
@@ -162,6 +167,7 @@ pub fn run(a: Args) -> Result<u8> {
         material: a.material.clone(),
         height: HeightSettings {
             strength,
+            height_range,
             filter: a.filter.into(),
             invert: a.invert,
             channel: a.channel.into(),

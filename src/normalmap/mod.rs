@@ -202,6 +202,28 @@ pub fn normals_from_height(height: &HeightPlane, opts: &Options, progress: &Repo
     NormalPlane { width: w, height: h, data }
 }
 
+/// The height's slope at every texel, `[dh/dx, dh/dy_up]` per texel of `height` (x right, y
+/// towards the top row), through `opts`' filter and wrap; `opts.strength` and `invert` do not
+/// apply. For conversions whose scale varies over the map ([`crate::bake::surface`]).
+pub fn gradients(height: &HeightPlane, opts: &Options) -> Vec<[f32; 2]> {
+    let mut data = vec![[0.0f32; 2]; height.width * height.height];
+    let (w, none) = (height.width, Reporter::none());
+    rows::for_each_row(
+        height,
+        opts,
+        &mut data,
+        w,
+        &none,
+        || (),
+        |_, _, gx, gy, out, _| {
+            for ((o, &dx), &dy) in out.iter_mut().zip(gx).zip(gy) {
+                *o = [dx, dy];
+            }
+        },
+    );
+    data
+}
+
 /// The name other commands use: [`normals_from_height`] without progress.
 pub fn height_to_normal(height: &HeightPlane, opts: &Options) -> NormalPlane {
     normals_from_height(height, opts, &Reporter::none())
