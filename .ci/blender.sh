@@ -16,5 +16,5 @@ WHEEL="$wheel" bash blender/build.sh
 py=$(bash .ci/python-of.sh 3.11)
 "$py" -m venv "$work/venv"
 "$work/venv/bin/pip" install --quiet --disable-pip-version-check -r blender/requirements-ci.txt
-BLENDER_USER_RESOURCES="$work/user" BUMPBAKE_BLENDER_ZIP="$PWD/target/blender/bumpbake.zip" \
+BLENDER_USER_RESOURCES="$work/user" BUMPBAKE_VALIDATED_DIR="$target/tmp/validated/blender" BUMPBAKE_BLENDER_ZIP="$PWD/target/blender/bumpbake.zip" \
   "$work/venv/bin/python" -m pytest -q -p no:cacheprovider blender/tests

@@ -4,43 +4,21 @@ against what the stock exporter writes."""
 
 from __future__ import annotations
 
-import json
-import os
-import struct
-import tempfile
-import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
-
-os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="bumpbake-blender-"))
+from conftest import clear_scene, findings, glb_json, keep_for_khronos, new_material
 
 bpy = pytest.importorskip("bpy")
-import numpy as np  # noqa: E402
-
-ZIP = Path(os.environ.get("BUMPBAKE_BLENDER_ZIP", Path(__file__).resolve().parents[2] / "target/blender/bumpbake.zip"))
-
-
-@pytest.fixture(scope="module", autouse=True)
-def installed():
-    assert ZIP.exists(), f"{ZIP}: run blender/build.sh first"
-    result = bpy.ops.extensions.package_install_files(filepath=str(ZIP), repo="user_default", enable_on_install=True)
-    assert "FINISHED" in result
-    assert hasattr(bpy.ops.bumpbake, "export_gltf")
-    yield
 
 
 def suzanne_with_a_normal_map(tmp: Path):
-    for o in list(bpy.data.objects):
-        bpy.data.objects.remove(o)
+    clear_scene()
     bpy.ops.mesh.primitive_monkey_add()
     obj = bpy.context.object
     bpy.ops.object.shade_smooth()
-    mat = bpy.data.materials.new("Skin")
-    with warnings.catch_warnings():
-        # Blender 5 gives every material nodes and deprecates the switch; 4.2 needs it.
-        warnings.simplefilter("ignore", DeprecationWarning)
-        mat.use_nodes = True
+    mat = new_material("Skin")
     nt = mat.node_tree
     size = 64
     y, x = np.mgrid[0:size, 0:size] / size
@@ -63,24 +41,6 @@ def suzanne_with_a_normal_map(tmp: Path):
     return obj
 
 
-def findings(path: Path) -> dict:
-    import bumpbake
-
-    report = bumpbake.validate(path)
-    codes = {}
-    for f in report["files"]:
-        for s in f.get("subjects", []):
-            for fi in s.get("findings", []):
-                codes[fi["code"]] = fi
-    return codes
-
-
-def glb_json(path: Path) -> dict:
-    data = path.read_bytes()
-    n = struct.unpack_from("<I", data, 12)[0]
-    return json.loads(data[20 : 20 + n])
-
-
 def test_export_gltf_writes_mikktspace_tangents_where_the_stock_exporter_does_not(tmp_path):
     suzanne_with_a_normal_map(tmp_path)
     stock = tmp_path / "stock.glb"
@@ -96,6 +56,7 @@ def test_export_gltf_writes_mikktspace_tangents_where_the_stock_exporter_does_no
     prim = doc["meshes"][0]["primitives"][0]
     assert "TANGENT" in prim["attributes"] and "normalTexture" in doc["materials"][prim["material"]]
     assert "bumpbake validate: 0 error(s)" in bpy.context.window_manager["bumpbake_last_report"]
+    keep_for_khronos(ours, "suzanne.glb")
 
 
 def test_the_stock_dialogs_checkbox_does_the_same(tmp_path):
