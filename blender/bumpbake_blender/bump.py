@@ -134,15 +134,17 @@ def height_of(image, socket: str) -> np.ndarray:
 
 
 def normal_image(name: str, normals: np.ndarray, float_buffer: bool):
-    """A Blender image of unit normals (rows from the top), encoded `n/2 + 1/2`, Non-Color."""
+    """A Blender image of unit normals (rows from the top), encoded `n/2 + 1/2`, Non-Color, not
+    yet saved or packed."""
     h, w, _ = normals.shape
     img = bpy.data.images.new(name, w, h, alpha=False, float_buffer=float_buffer)
     img.colorspace_settings.name = "Non-Color"
     rgba = np.ones((h, w, 4), dtype=np.float32)
     rgba[:, :, :3] = normals[::-1] * 0.5 + 0.5
     img.pixels.foreach_set(rgba.reshape(-1))
+    # Left in memory, as Cycles leaves its bakes: packing encodes the image (most of the
+    # operator's time at 1024²), and the artist chooses to pack or save it.
     img.update()
-    img.pack()
     return img
 
 

@@ -187,3 +187,67 @@ def test_progress_is_called_per_stage():
     bumpbake.normalmap(heights(256, 64).astype(np.float32), progress=lambda *a: calls.append(a))
     assert calls[0][0] == "normalmap" and calls[-1][1] == calls[-1][2] == 256
     assert all(c[3] == "rows" for c in calls)
+
+
+def stretched_plane(tmp_path):
+    """A plane [0, 3] x [0, 1] (z up) as an OBJ, and the same as arrays (OBJ's UVs: bottom-left)."""
+    p, n, uv, idx = _plane_arrays()
+    lines = [f"v {a} {b} {c}" for a, b, c in p] + [f"vt {a} {b}" for a, b in uv] + ["vn 0 0 1"]
+    lines += [f"f {' '.join(f'{i + 1}/{i + 1}/1' for i in t)}" for t in idx]
+    obj = tmp_path / "plane.obj"
+    obj.write_text("\n".join(lines) + "\n")
+    return obj, p, n, uv, idx
+
+
+def test_bump_to_normal_equals_bake_with_a_height_range(tmp_path):
+    obj, p, n, uv, idx = stretched_plane(tmp_path)
+    h = np.round(heights(64, 64) * 65535).astype(np.uint16)
+    src = tmp_path / "h.png"
+    write_png(src, h)
+    out = tmp_path / "out.gltf"
+    bumpbake.bake(obj, out, height=src, height_range=0.05, bits16=True, images="external")
+    png = next(tmp_path.glob("out_image*.png"))
+    want = read_png(png).astype(np.int64)
+    got = bumpbake.bump_to_normal(
+        h, p, n, uv, idx, distance=0.05, uv_origin="bottom-left", filter="sobel", wrap="repeat", bits=16
+    )
+    assert got.dtype == np.uint16 and got.shape == want.shape
+    # The command line moves the mesh to its own centre before the same float arithmetic.
+    assert np.abs(got.astype(np.int64) - want).max() <= 2
+    # And not a flat map: the relief is there.
+    assert np.abs(want[..., 0] - 32768).max() > 1000
+
+
+def test_bump_to_normal_given_tangents_and_top_left_uvs_agree():
+    p, n, uv, idx = _plane_arrays()
+    h = heights(32, 32).astype(np.float32)
+    base = bumpbake.bump_to_normal(h, p, n, uv, idx, distance=0.1, uv_origin="bottom-left", bits=32)
+    flipped = uv.copy()
+    flipped[:, 1] = 1 - flipped[:, 1]
+    assert np.array_equal(base, bumpbake.bump_to_normal(h, p, n, flipped, idx, distance=0.1, bits=32))
+    t = bumpbake.tangents(p, n, uv, idx, uv_origin="bottom-left")
+    given = bumpbake.bump_to_normal(h, p, n, uv, idx, t, distance=0.1, uv_origin="bottom-left", bits=32)
+    assert np.array_equal(base, given)
+    assert np.allclose(np.linalg.norm(base, axis=2), 1, atol=1e-6)
+    inverted = bumpbake.bump_to_normal(h, p, n, uv, idx, distance=0.1, invert=True, uv_origin="bottom-left", bits=32)
+    assert np.allclose(inverted[..., :2], -base[..., :2], atol=1e-6)
+    _, info = bumpbake.bump_to_normal(h, p, n, uv, idx, distance=0.1, uv_origin="bottom-left", report=True)
+    assert info["covered"] == 32 * 32 and info["uncovered"] == 0
+
+
+def _plane_arrays():
+    p = np.array([[0, 0, 0], [3, 0, 0], [3, 1, 0], [0, 1, 0]], np.float32)
+    uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32)
+    n = np.tile(np.array([0, 0, 1], np.float32), (4, 1))
+    return p, n, uv, np.array([[0, 1, 2], [0, 2, 3]], np.uint32)
+
+
+def test_bump_to_normal_refuses_bad_input():
+    p, n, uv, idx = _plane_arrays()
+    h = heights(8, 8).astype(np.float32)
+    with pytest.raises(bumpbake.UsageError, match="distance"):
+        bumpbake.bump_to_normal(h, p, n, uv, idx, distance=float("nan"))
+    with pytest.raises(bumpbake.InputError, match="normals has 3 rows"):
+        bumpbake.bump_to_normal(h, p, n[:3], uv, idx, distance=0.1)
+    with pytest.raises(bumpbake.InputError, match="indices"):
+        bumpbake.bump_to_normal(h, p, n, uv, idx + 4, distance=0.1)

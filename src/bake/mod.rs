@@ -107,8 +107,9 @@ pub fn run_from(job: &BakeJob, high: Vec<crate::transfer::high::HighMesh>) -> Re
     })?;
     if let Some(range) = job.height.height_range {
         for h in &through {
-            let (png, warning) =
-                t.time("maps", || maps::through_mesh(&scene, h.material, &h.path, h.multiplier, range, &job.height))?;
+            let (png, warning) = t.time("maps through mesh", || {
+                maps::through_mesh(&scene, h.material, &h.path, h.multiplier, range, &job.height)
+            })?;
             warnings.extend(warning);
             maps::replace_normal_image(&mut scene, h.material, &png);
         }

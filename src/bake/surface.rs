@@ -24,7 +24,7 @@
 
 use crate::normalmap::{self, Filter, HeightPlane, NormalPlane, Options, Wrap};
 use crate::transfer::{pad, raster};
-use glam::DVec3;
+use glam::{DVec3, Vec3A};
 use rayon::prelude::*;
 
 /// A triangle mesh placed in the world: corners indexed by `triangles`, one entry per vertex in
@@ -74,12 +74,13 @@ pub struct SurfaceMap {
     pub uncovered: usize,
 }
 
-/// The world-space layout of one triangle over texel space.
+/// The world-space layout of one triangle over texel space (solved in f64, used in f32: the
+/// per-texel arithmetic is the conversion's cost).
 #[derive(Clone, Copy)]
 struct Jacobian {
     /// `dP/dx`, `dP/dy` per texel (y down, as rows run).
-    px: DVec3,
-    py: DVec3,
+    px: Vec3A,
+    py: Vec3A,
 }
 
 fn jacobian(p: [DVec3; 3], t: [[f64; 2]; 3]) -> Jacobian {
@@ -87,11 +88,12 @@ fn jacobian(p: [DVec3; 3], t: [[f64; 2]; 3]) -> Jacobian {
     let (d1, d2) = ([t[1][0] - t[0][0], t[1][1] - t[0][1]], [t[2][0] - t[0][0], t[2][1] - t[0][1]]);
     let det = d1[0] * d2[1] - d2[0] * d1[1];
     if det == 0.0 || !det.is_finite() {
-        return Jacobian { px: DVec3::ZERO, py: DVec3::ZERO };
+        return Jacobian { px: Vec3A::ZERO, py: Vec3A::ZERO };
     }
     // [e1 e2] = [px py]·[d1 d2]  =>  [px py] = [e1 e2]·[d1 d2]⁻¹
     let inv = 1.0 / det;
-    Jacobian { px: (e1 * d2[1] - e2 * d1[1]) * inv, py: (e2 * d1[0] - e1 * d2[0]) * inv }
+    let f = |v: DVec3| Vec3A::new(v.x as f32, v.y as f32, v.z as f32);
+    Jacobian { px: f((e1 * d2[1] - e2 * d1[1]) * inv), py: f((e2 * d1[0] - e1 * d2[0]) * inv) }
 }
 
 fn dvec(v: [f32; 3]) -> DVec3 {
@@ -100,15 +102,15 @@ fn dvec(v: [f32; 3]) -> DVec3 {
 
 /// The bumped world normal at a point whose shading normal is `n` (unit), height slope `(hx, hy)`
 /// per texel (y down), on a triangle laid out by `j`.
-fn bumped(n: DVec3, j: &Jacobian, hx: f64, hy: f64, b: &Bump) -> DVec3 {
+fn bumped(n: Vec3A, j: &Jacobian, hx: f32, hy: f32, b: &Bump) -> Vec3A {
     let det = n.dot(j.px.cross(j.py));
     if det == 0.0 || !det.is_finite() {
         return n;
     }
-    let d = if b.invert { -b.distance } else { b.distance };
+    let d = if b.invert { -b.distance } else { b.distance } as f32;
     let grad = (j.py * hx - j.px * hy).cross(n) / det;
     let bumped = (n - grad * d).normalize_or(n);
-    let s = b.strength.max(0.0);
+    let s = b.strength.max(0.0) as f32;
     if s == 1.0 {
         return bumped;
     }
@@ -117,15 +119,14 @@ fn bumped(n: DVec3, j: &Jacobian, hx: f64, hy: f64, b: &Bump) -> DVec3 {
 
 /// `v` in the frame `(t, b, n)`: the solution of `x·t + y·b + z·n = v`, normalised; the frame's
 /// transpose when it is singular.
-fn in_frame(v: DVec3, t: DVec3, b: DVec3, n: DVec3) -> [f32; 3] {
+fn in_frame(v: Vec3A, t: Vec3A, b: Vec3A, n: Vec3A) -> [f32; 3] {
     let det = t.dot(b.cross(n));
-    let x = if det.abs() > 1e-12 {
-        DVec3::new(v.dot(b.cross(n)), v.dot(n.cross(t)), v.dot(t.cross(b))) / det
+    let x = if det.abs() > 1e-6 {
+        Vec3A::new(v.dot(b.cross(n)), v.dot(n.cross(t)), v.dot(t.cross(b))) / det
     } else {
-        DVec3::new(v.dot(t), v.dot(b), v.dot(n))
+        Vec3A::new(v.dot(t), v.dot(b), v.dot(n))
     };
-    let x = x.normalize_or(DVec3::Z);
-    [x.x as f32, x.y as f32, x.z as f32]
+    x.normalize_or(Vec3A::Z).to_array()
 }
 
 /// The normal map of `height` through `mesh` (at the height's size). A texel outside every UV
@@ -158,18 +159,19 @@ pub fn surface_normals(mesh: &SurfaceMesh, height: &HeightPlane, b: &Bump) -> Su
             let Some(e) = &edges[t as usize] else { continue };
             let (sx, sy) = raster::sample_pos(x, y, 0, 1);
             let bc = e.bary(sx, sy);
-            let tri = mesh.triangles[t as usize];
-            let lerp = |f: &dyn Fn(usize) -> DVec3| (0..3).map(|k| f(tri[k] as usize) * bc[k] as f64).sum::<DVec3>();
-            let n = lerp(&|v| dvec(mesh.normals[v]));
-            let tan = lerp(&|v| {
-                let q = mesh.tangents[v];
-                dvec([q[0], q[1], q[2]])
-            });
-            let sign: f32 = tri.iter().map(|&v| mesh.tangents[v as usize][3]).sum();
+            let tri = mesh.triangles[t as usize].map(|v| v as usize);
+            let [b0, b1, b2] = bc;
+            let lerp =
+                |a: [f32; 3], b: [f32; 3], c: [f32; 3]| Vec3A::from(a) * b0 + Vec3A::from(b) * b1 + Vec3A::from(c) * b2;
+            let (nv, tv) = (mesh.normals, mesh.tangents);
+            let n = lerp(nv[tri[0]], nv[tri[1]], nv[tri[2]]);
+            let xyz = |q: [f32; 4]| [q[0], q[1], q[2]];
+            let tan = lerp(xyz(tv[tri[0]]), xyz(tv[tri[1]]), xyz(tv[tri[2]]));
+            let sign = tv[tri[0]][3] + tv[tri[1]][3] + tv[tri[2]][3];
             let bit = n.cross(tan) * if sign < 0.0 { -1.0 } else { 1.0 };
-            let unit = n.normalize_or(DVec3::Z);
+            let unit = n.normalize_or(Vec3A::Z);
             let [gx, gy_up] = grad[i];
-            let world = bumped(unit, &jac[t as usize], gx as f64, -(gy_up as f64), b);
+            let world = bumped(unit, &jac[t as usize], gx, -gy_up, b);
             *out = in_frame(world, tan, bit, n);
         }
     });
@@ -218,23 +220,23 @@ mod tests {
     /// Strength mixes as Cycles mixes; Invert negates the distance.
     #[test]
     fn strength_and_invert_follow_the_bump_node() {
-        let n = DVec3::Z;
-        let j = Jacobian { px: DVec3::X, py: -DVec3::Y };
+        let n = Vec3A::Z;
+        let j = Jacobian { px: Vec3A::X, py: -Vec3A::Y };
         let full = bumped(n, &j, 0.5, 0.0, &Bump::default());
-        assert!((full - DVec3::new(-0.5, 0.0, 1.0).normalize()).length() < 1e-12);
+        assert!((full - Vec3A::new(-0.5, 0.0, 1.0).normalize()).length() < 1e-6);
         let half = bumped(n, &j, 0.5, 0.0, &Bump { strength: 0.5, ..Default::default() });
-        assert!((half - (full * 0.5 + n * 0.5).normalize()).length() < 1e-12);
+        assert!((half - (full * 0.5 + n * 0.5).normalize()).length() < 1e-6);
         let inv = bumped(n, &j, 0.5, 0.0, &Bump { invert: true, ..Default::default() });
-        assert!((inv - DVec3::new(0.5, 0.0, 1.0).normalize()).length() < 1e-12);
+        assert!((inv - Vec3A::new(0.5, 0.0, 1.0).normalize()).length() < 1e-6);
     }
 
     /// A frame that is not orthonormal is inverted, not transposed.
     #[test]
     fn skewed_frames_are_inverted() {
-        let (t, b, n) = (DVec3::new(1.0, 0.2, 0.1), DVec3::new(0.1, 1.0, 0.0), DVec3::new(0.0, 0.1, 1.0));
+        let (t, b, n) = (Vec3A::new(1.0, 0.2, 0.1), Vec3A::new(0.1, 1.0, 0.0), Vec3A::new(0.0, 0.1, 1.0));
         let v = (t * 0.3 + b * -0.2 + n * 0.9).normalize();
         let x = in_frame(v, t, b, n);
-        let back = (t * x[0] as f64 + b * x[1] as f64 + n * x[2] as f64).normalize();
-        assert!(back.angle_between(v) < 1e-6);
+        let back = (t * x[0] + b * x[1] + n * x[2]).normalize();
+        assert!(back.angle_between(v) < 1e-5);
     }
 }
