@@ -42,7 +42,7 @@ def stage(target):
     cam.rotation_quaternion = Vector(d).to_track_quat("-Z", "Y")
     scene.camera = cam
     sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
-    sun.data.energy = 4.0
+    sun.data.energy = 2.0
     sun.rotation_euler = (0.9, 0.2, 0.6)
     scene.collection.objects.link(sun)
     scene.render.engine = "CYCLES"
@@ -79,7 +79,7 @@ def save(name: str, rgb: np.ndarray):
 def main():
     OUT.mkdir(parents=True, exist_ok=True)
     bpy.ops.extensions.package_install_files(filepath=str(conftest.ZIP), repo="user_default", enable_on_install=True)
-    obj, _ = test_bump.bump_scene("sphere", distance=0.05)
+    obj, _ = test_bump.bump_scene("sphere", distance=0.2)
     stage((0, 0, 0))
     before = render()
     obj.select_set(True)
@@ -88,7 +88,7 @@ def main():
     gap = np.ones((SIZE, 8, 3), np.float32)
     save("blender-bump-to-normal.png", np.concatenate([before, gap, np.abs(after - before) * 10, gap, after], axis=1))
 
-    obj, _ = test_bump.bump_scene("sphere", distance=0.05)
+    obj, _ = test_bump.bump_scene("sphere", distance=0.2)
     glb = Path(tempfile.mkdtemp()) / "bumpy.glb"
     bpy.ops.bumpbake.export_gltf(filepath=str(glb))
     import bumpbake._native as native

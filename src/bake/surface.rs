@@ -186,8 +186,10 @@ pub fn surface_normals(mesh: &SurfaceMesh, height: &HeightPlane, b: &Bump) -> Su
 mod tests {
     use super::*;
 
+    type Quad = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 4]>, Vec<[f32; 2]>, Vec<[u32; 3]>);
+
     /// A flat quad over `[0, sx] x [0, sy]` (z up), its UV square mapped whole, v down towards -y.
-    fn quad(sx: f32, sy: f32) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 4]>, Vec<[f32; 2]>, Vec<[u32; 3]>) {
+    fn quad(sx: f32, sy: f32) -> Quad {
         let p = vec![[0.0, sy, 0.0], [sx, sy, 0.0], [sx, 0.0, 0.0], [0.0, 0.0, 0.0]];
         let uv = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
         (p, vec![[0.0, 0.0, 1.0]; 4], vec![[1.0, 0.0, 0.0, 1.0]; 4], uv, vec![[0, 3, 2], [0, 2, 1]])
