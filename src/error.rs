@@ -54,6 +54,10 @@ pub enum Setting {
     Strength,
     /// The surface height of a height map's `h = 1`, in the mesh's (or metres') units.
     HeightRange,
+    /// The size of one texel on the surface, in the units of the height range.
+    TexelSize,
+    /// The height map holds depth: white is deep (a switch).
+    Invert,
     /// A height map to bake into a normal map.
     Height,
     /// A normal map to bake.
@@ -65,7 +69,7 @@ pub enum Setting {
 impl Setting {
     /// Every setting, in declaration order (a new variant goes here too: the front ends' tests
     /// check each has a name).
-    pub const EVERY: [Setting; 21] = [
+    pub const EVERY: [Setting; 23] = [
         Setting::Convention,
         Setting::Material,
         Setting::MaxPixels,
@@ -84,6 +88,8 @@ impl Setting {
         Setting::Channel,
         Setting::Strength,
         Setting::HeightRange,
+        Setting::TexelSize,
+        Setting::Invert,
         Setting::Height,
         Setting::Normal,
         Setting::High,
@@ -110,6 +116,8 @@ impl Setting {
             Setting::Channel => "channel",
             Setting::Strength => "strength",
             Setting::HeightRange => "height_range",
+            Setting::TexelSize => "texel_size",
+            Setting::Invert => "invert",
             Setting::Height => "height",
             Setting::Normal => "normal",
             Setting::High => "high",

@@ -190,21 +190,12 @@ def _height(a: Any) -> tuple[np.ndarray, str]:
 
 
 def _strength(strength: float | None, height_range: float | None, texel_size: float | None) -> float:
-    if strength is not None and (height_range is not None or texel_size is not None):
-        raise UsageError("strength cannot be given with height_range and texel_size: give one or the other")
-    if (height_range is None) != (texel_size is None):
-        raise UsageError("height_range and texel_size go together: give both, or strength alone")
-    if height_range is not None and texel_size is not None:
-        if not (np.isfinite(texel_size) and texel_size > 0):
-            raise UsageError(f"texel_size={texel_size!r}: must be a positive length")
-        if not (np.isfinite(height_range) and height_range >= 0):
-            raise UsageError(f"height_range={height_range!r}: must be zero or a positive length")
-        s = float(np.float32(float(height_range) / float(texel_size)))
-    else:
-        s = 1.0 if strength is None else float(np.float32(strength))
-    if not (np.isfinite(s) and s >= 0):
-        raise UsageError(f"strength={s!r}: must be finite and not negative (use invert=True for depth maps)")
-    return s
+    """The library's rule (the command line's too): one of strength, or height_range with texel_size."""
+    for name, v in (("strength", strength), ("height_range", height_range), ("texel_size", texel_size)):
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer))):
+            raise UsageError(f"{name}={v!r}: give a number")
+    as_float = [None if v is None else float(v) for v in (strength, height_range, texel_size)]
+    return _native.strength(*as_float)
 
 
 def normalmap(

@@ -25,6 +25,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(arrays::tangents, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::normalmap, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::bump_to_normal, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::strength, m)?)?;
     m.add_function(wrap_pyfunction!(commands::run, m)?)?;
     m.add_function(wrap_pyfunction!(commands::main, m)?)?;
     m.add_function(wrap_pyfunction!(commands::options, m)?)?;

@@ -140,15 +140,17 @@ pub struct Args {
 pub fn run(a: Args) -> Result<u8> {
     let outputs = a.io.outputs(&a.batch.out_dir)?;
     let (strength, height_range) = match (a.height_range, a.texel_size) {
-        (Some(r), Some(t)) if t > 0.0 && r.is_finite() && t.is_finite() => (r / t, None),
-        (Some(_), Some(_)) => return Err(Error::usage("--texel-size must be a positive number")),
-        (Some(r), None) if r.is_finite() => (1.0, Some(r as f64)),
-        (Some(_), None) => return Err(Error::usage("--height-range must be finite")),
-        _ => (a.strength, None),
+        // Alone, the range is a height on the mesh, whose texels have their own sizes.
+        (Some(r), None) => {
+            // Checks the range as a length; the strength stays 1 (the mesh sets each texel's size).
+            bumpbake::normalmap::Options::strength_from(None, Some(r as f64), Some(1.0))?;
+            (1.0, Some(r as f64))
+        }
+        (r, t) => {
+            let strength = (r.is_none()).then_some(a.strength);
+            (bumpbake::normalmap::Options::strength_from(strength, r.map(f64::from), t.map(f64::from))?, None)
+        }
     };
-    if !strength.is_finite() {
-        return Err(Error::usage("--strength must be finite"));
-    }
     let transfer = transfer_settings(&a)?;
     let textures = match (a.textures, a.encode.given()) {
         (TexturesArg::Ktx2, _) => Some(a.encode.options()?),

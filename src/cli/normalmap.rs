@@ -82,25 +82,7 @@ pub struct Args {
 }
 
 fn strength(args: &Args) -> Result<f32> {
-    let s = match (args.strength, args.height_range, args.texel_size) {
-        (Some(s), _, _) => s,
-        (None, Some(range), Some(texel)) => {
-            if !(texel.is_finite() && texel > 0.0) {
-                return Err(Error::usage(format!("--texel-size {texel}: must be a positive length")));
-            }
-            if !(range.is_finite() && range >= 0.0) {
-                return Err(Error::usage(format!("--height-range {range}: must be zero or a positive length")));
-            }
-            Options::physical_strength(range, texel)
-        }
-        _ => Options::default().strength,
-    };
-    if !(s.is_finite() && s >= 0.0) {
-        return Err(Error::usage(format!(
-            "strength {s}: must be finite and not negative (use --invert for depth maps)"
-        )));
-    }
-    Ok(s)
+    Options::strength_from(args.strength, args.height_range, args.texel_size)
 }
 
 /// The extension of the outputs, after checking `--textures` against `-o` and `--out-ext`.

@@ -157,6 +157,53 @@ impl Options {
     pub fn physical_strength(height_range: f64, texel_size: f64) -> f32 {
         (height_range / texel_size) as f32
     }
+
+    /// The strength a caller asked for: `strength` alone, or `height_range` and `texel_size`
+    /// together ([`Options::physical_strength`]), or the default; refused (a usage error naming
+    /// the setting) when both ways are given, when one of the pair is missing, or when a value is
+    /// not a finite length (the texel size positive) or the strength is negative.
+    pub fn strength_from(
+        strength: Option<f32>,
+        height_range: Option<f64>,
+        texel_size: Option<f64>,
+    ) -> crate::error::Result<f32> {
+        use crate::error::{Error, Setting, Words};
+        let refuse = |s: Setting, v: String, rest: &str| {
+            Err(Error::setting(s, Some(v.clone()), Words::new().given(s, v).text(rest)))
+        };
+        let s = match (strength, height_range, texel_size) {
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+                let w = Words::new().name(Setting::Strength).text(" cannot be given with ").name(Setting::HeightRange);
+                let w = w.text(" and ").name(Setting::TexelSize).text(": give one or the other");
+                return Err(Error::setting(Setting::Strength, None, w));
+            }
+            (None, Some(_), None) | (None, None, Some(_)) => {
+                let w = Words::new().name(Setting::HeightRange).text(" and ").name(Setting::TexelSize);
+                let w = w.text(" go together: give both, or ").name(Setting::Strength).text(" alone");
+                return Err(Error::setting(Setting::HeightRange, None, w));
+            }
+            (Some(s), None, None) => s,
+            (None, Some(range), Some(texel)) => {
+                if !(texel.is_finite() && texel > 0.0) {
+                    return refuse(Setting::TexelSize, texel.to_string(), ": must be a positive length");
+                }
+                if !(range.is_finite() && range >= 0.0) {
+                    return refuse(Setting::HeightRange, range.to_string(), ": must be zero or a positive length");
+                }
+                Options::physical_strength(range, texel)
+            }
+            (None, None, None) => Options::default().strength,
+        };
+        if !(s.is_finite() && s >= 0.0) {
+            let w = Words::new().given(Setting::Strength, s).text(": must be finite and not negative (use ");
+            return Err(Error::setting(
+                Setting::Strength,
+                Some(s.to_string()),
+                w.on(Setting::Invert).text(" for depth maps)"),
+            ));
+        }
+        Ok(s)
+    }
     /// The strength with the inversion folded in: `d(1-h) = -dh`.
     pub(crate) fn signed_strength(&self) -> f32 {
         if self.invert {
