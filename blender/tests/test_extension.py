@@ -84,3 +84,10 @@ def test_ktx2_normal_maps(tmp_path):
 def test_a_path_that_is_not_gltf_is_refused(tmp_path):
     with pytest.raises(RuntimeError, match=r"give a \.glb or \.gltf path"):
         bpy.ops.bumpbake.export_gltf(filepath=str(tmp_path / "model.fbx"))
+
+
+def test_the_panels_are_in_material_and_render_bake():
+    material = bpy.types.Panel.bl_rna_get_subclass_py("BUMPBAKE_PT_material")
+    bake = bpy.types.Panel.bl_rna_get_subclass_py("BUMPBAKE_PT_bake")
+    assert material is not None and material.bl_context == "material"
+    assert bake is not None and bake.bl_parent_id == "CYCLES_RENDER_PT_bake"
