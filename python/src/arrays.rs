@@ -388,7 +388,12 @@ pub fn bump_to_normal(
 /// `height_range` and `texel_size` ([`Options::strength_from`]), its refusals as `UsageError`s.
 #[pyfunction]
 #[pyo3(signature = (strength, height_range, texel_size))]
-pub fn strength(py: Python<'_>, strength: Option<f32>, height_range: Option<f64>, texel_size: Option<f64>) -> PyResult<f32> {
+pub fn strength(
+    py: Python<'_>,
+    strength: Option<f32>,
+    height_range: Option<f64>,
+    texel_size: Option<f64>,
+) -> PyResult<f32> {
     crate::errors::speak_keywords();
     Options::strength_from(strength, height_range, texel_size)
         .map_err(|e| crate::errors::from_library(py, &e, str::to_string))
