@@ -3,7 +3,7 @@ of RUNS: `bump_to_normal` against Cycles' NORMAL bake of the Bump material (1024
 scenes), and `bake_selected_to_active` against Cycles' selected-to-active NORMAL bake of the same
 pair (a bumpy sphere of HIGH triangles onto a 48x24 one, 1024², one sample each).
 
-    BUMPBAKE_BLENDER_ZIP=target/blender/bumpbake.zip python blender/benches/operators.py [RUNS] [OUT.json]
+    BUMPBAKE_BLENDER_ZIP=target/blender/bumpbake.zip python blender/benches/operators.py [RUNS] [OUT] [PARTS]
 
 Run with the bpy venv's Python (bpy 5.0.1); figures in docs/blender.md."""
 
@@ -27,6 +27,8 @@ import test_selected
 
 RUNS = int(sys.argv[1]) if len(sys.argv) > 1 else 3
 OUT = sys.argv[2] if len(sys.argv) > 2 else None
+PARTS = (sys.argv[3] if len(sys.argv) > 3 else "bump,selected").split(",")
+SAMPLES = (1, 16)
 
 
 def cycles_selected(mat, size: int, samples: int) -> float:
@@ -59,8 +61,8 @@ def main():
     )
     assert "FINISHED" in result
     rows = {"runs": RUNS, "load": os.getloadavg(), "bump_to_normal": {}, "selected_to_active": {}}
-    for kind in ("plane", "stretched", "sphere"):
-        for samples in (1, 16):
+    for kind in ("plane", "stretched", "sphere") if "bump" in PARTS else ():
+        for samples in SAMPLES:
             ours, cycles = [], []
             for _ in range(RUNS):
                 obj, mat = test_bump.bump_scene(kind, distance=0.05)
@@ -79,7 +81,7 @@ def main():
             print(
                 f"bump_to_normal {kind}, Cycles samples {samples}: bumpbake {o:.3f} s, Cycles {c:.2f} s, {c / o:.1f}x"
             )
-    for segments in (192, 768, 1536):
+    for segments in (192, 768) if "selected" in PARTS else ():
         ours, cycles = [], []
         tris = 0
         for _ in range(RUNS):
