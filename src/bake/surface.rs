@@ -74,6 +74,9 @@ pub struct SurfaceMap {
     pub uncovered: usize,
 }
 
+/// Rows of the map one task rasterises and converts.
+const BAND: usize = 32;
+
 /// The world-space layout of one triangle over texel space (solved in f64, used in f32: the
 /// per-texel arithmetic is the conversion's cost).
 #[derive(Clone, Copy)]
@@ -146,17 +149,31 @@ pub fn surface_normals(mesh: &SurfaceMesh, height: &HeightPlane, b: &Bump) -> Su
         .iter()
         .map(|t| jacobian(t.map(|i| dvec(mesh.positions[i as usize])), t.map(|i| texel(mesh.uvs[i as usize]))))
         .collect();
-    let candidates: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
-    let owners = raster::band(&edges, &candidates, 0, h, w, 1);
+    // Bands of rows, each rasterised and converted by one task: the triangles that reach a band
+    // are its candidates, in index order (the first wins where UVs overlap).
+    let rows = BAND.min(h.max(1));
+    let bands = h.div_ceil(rows);
+    let mut candidates: Vec<Vec<u32>> = vec![Vec::new(); bands];
+    for (t, e) in edges.iter().enumerate() {
+        let Some(e) = e else { continue };
+        let band_of = |y: f32| ((y.max(0.0) as usize) / rows).min(bands.saturating_sub(1));
+        (band_of(e.min[1])..=band_of(e.max[1])).for_each(|b| candidates[b].push(t as u32));
+    }
     let mut normals = vec![[0.0f32, 0.0, 1.0]; w * h];
-    normals.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.iter_mut().enumerate() {
-            let i = y * w + x;
-            let t = owners.owner[i];
+    let mut filled = vec![false; w * h];
+    let chunk = w.max(1) * rows;
+    normals.par_chunks_mut(chunk).zip(filled.par_chunks_mut(chunk)).enumerate().for_each(|(k, (out, fill))| {
+        let y0 = k * rows;
+        let owners = raster::band(&edges, &candidates[k], y0, y0 + out.len() / w.max(1), w, 1);
+        for (j, out) in out.iter_mut().enumerate() {
+            let t = owners.owner[j];
             if t == u32::MAX {
                 continue;
             }
             let Some(e) = &edges[t as usize] else { continue };
+            fill[j] = true;
+            let (x, y) = (j % w, y0 + j / w);
+            let i = y * w + x;
             let (sx, sy) = raster::sample_pos(x, y, 0, 1);
             let bc = e.bary(sx, sy);
             let tri = mesh.triangles[t as usize].map(|v| v as usize);
@@ -175,7 +192,6 @@ pub fn surface_normals(mesh: &SurfaceMesh, height: &HeightPlane, b: &Bump) -> Su
             *out = in_frame(world, tan, bit, n);
         }
     });
-    let mut filled: Vec<bool> = owners.owner.iter().map(|&o| o != u32::MAX).collect();
     let covered = filled.iter().filter(|&&f| f).count();
     let padded = pad::pad(w, h, &mut normals, &mut filled, b.padding);
     let uncovered = filled.iter().filter(|&&f| !f).count();
