@@ -3,7 +3,7 @@ of RUNS: `bump_to_normal` against Cycles' NORMAL bake of the Bump material (1024
 scenes), and `bake_selected_to_active` against Cycles' selected-to-active NORMAL bake of the same
 pair (a bumpy sphere of HIGH triangles onto a 48x24 one, 1024², one sample each).
 
-    BUMPBAKE_BLENDER_ZIP=target/blender/bumpbake.zip python blender/benches/operators.py [RUNS] [OUT] [PARTS]
+    BUMPBAKE_BLENDER_ZIP=target/blender/bumpbake.zip python blender/benches/operators.py [RUNS] [OUT] [PARTS] [SAMPLES]
 
 Run with the bpy venv's Python (bpy 5.0.1); figures in docs/blender.md."""
 
@@ -28,7 +28,7 @@ import test_selected
 RUNS = int(sys.argv[1]) if len(sys.argv) > 1 else 3
 OUT = sys.argv[2] if len(sys.argv) > 2 else None
 PARTS = (sys.argv[3] if len(sys.argv) > 3 else "bump,selected").split(",")
-SAMPLES = (1, 16)
+SAMPLES = tuple(int(s) for s in (sys.argv[4] if len(sys.argv) > 4 else "1,16").split(","))
 
 
 def cycles_selected(mat, size: int, samples: int) -> float:
