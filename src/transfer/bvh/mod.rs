@@ -14,11 +14,12 @@ mod bounds;
 mod collapse;
 mod morton;
 mod node;
+mod range;
 mod sah;
+mod small;
 
-use bounds::{bounds_of, Aabb, Item};
+use bounds::{bounds_of, Item};
 use collapse::Upper;
-use glam::Vec3A;
 pub use node::WideNode;
 
 /// Ranges smaller than this are built, bounded and binned on the current thread.
@@ -65,14 +66,8 @@ impl Bvh {
         if n == 0 {
             return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
         }
-        let mut items: Vec<Item> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let mut b = Aabb::EMPTY;
-                triangles[i].iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
-                Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
-            })
-            .collect();
+        let mut items: Vec<Item> =
+            (0..n).into_par_iter().map(|i| Item::of(positions, triangles[i], i as u32)).collect();
         let bc = bounds_of(&items);
         let upper = if morton::applies(n) {
             morton::build(&mut items, &bc.1)
@@ -121,6 +116,8 @@ impl Bvh {
 
 #[cfg(test)]
 pub(crate) mod tests {
+    use super::bounds::Aabb;
+    use glam::Vec3A;
     use super::*;
 
     /// A tree over unshared corners, as a triangle soup, and its positions.
