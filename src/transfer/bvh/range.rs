@@ -19,6 +19,8 @@ pub(super) struct Local {
     pub was: [Item; LOCAL],
     pub bounds: [Aabb; LOCAL],
     pub centre: [Vec3A; LOCAL],
+    /// The centres by axis, for the binning: one load an item, along the axis split.
+    along: [[f32; LOCAL]; 3],
 }
 
 /// Builds the subtree over `items` (at most [`LOCAL`], starting at `offset` in leaf order, with
@@ -26,11 +28,18 @@ pub(super) struct Local {
 pub(super) fn build(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, bc: (Aabb, Aabb)) {
     let n = items.len();
     debug_assert!((1..=LOCAL).contains(&n));
-    let mut l = Local { was: [items[0]; LOCAL], bounds: [Aabb::EMPTY; LOCAL], centre: [Vec3A::ZERO; LOCAL] };
+    let mut l = Local {
+        was: [items[0]; LOCAL],
+        bounds: [Aabb::EMPTY; LOCAL],
+        centre: [Vec3A::ZERO; LOCAL],
+        along: [[0.0; LOCAL]; 3],
+    };
     l.was[..n].copy_from_slice(items);
     for (i, it) in items.iter().enumerate() {
         l.bounds[i] = it.bounds();
-        l.centre[i] = it.centre();
+        let c = it.centre();
+        l.centre[i] = c;
+        (0..3).for_each(|a| l.along[a][i] = c[a]);
     }
     let mut idx = [0u8; LOCAL];
     idx.iter_mut().take(n).enumerate().for_each(|(i, x)| *x = i as u8);
@@ -71,14 +80,17 @@ impl Local {
         if e.is_nan() || e <= 0.0 {
             return None;
         }
-        let scale = BINS as f32 / (c.max[axis] - c.min[axis]);
+        let (lo, scale) = (c.min[axis], BINS as f32 / (c.max[axis] - c.min[axis]));
+        let along = &self.along[axis];
         let mut bins: Bins = [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS];
         let mut which = [0u8; LOCAL];
         for (w, &i) in which.iter_mut().zip(idx) {
-            let m = self.centre[i as usize];
-            let k = (((m[axis] - c.min[axis]) * scale) as usize).min(BINS - 1);
-            bins[k].0.join(&self.bounds[i as usize]);
-            bins[k].1.grow(m);
+            let i = i as usize;
+            // `as u32` floors and saturates as `sah::bin`'s `as usize` does for any value here
+            // (at least 0, or NaN), in fewer instructions.
+            let k = (((along[i] - lo) * scale) as u32).min(BINS as u32 - 1) as usize;
+            bins[k].0.join(&self.bounds[i]);
+            bins[k].1.grow(self.centre[i]);
             bins[k].2 += 1;
             *w = k as u8;
         }
