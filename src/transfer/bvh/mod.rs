@@ -1,8 +1,9 @@
 //! A bounding-volume hierarchy over HIGH's triangles, four children to a node.
 //!
-//! Built in two steps: a binary tree by the surface area heuristic (`sah.rs`), its upper levels
-//! split at Morton-code boundaries on a large HIGH (`morton.rs`), then collapsed to the four-wide
-//! nodes the rays walk (`collapse.rs`; both node layouts in `node.rs`).
+//! Built in two steps: a binary tree by the surface area heuristic (`sah.rs`; ranges of up to 256
+//! triangles in `range.rs`, of up to 16 in `small.rs`), its upper levels split at Morton-code
+//! boundaries on a large HIGH (`morton.rs`), then collapsed to the four-wide nodes the rays walk
+//! (`collapse.rs`; both node layouts in `node.rs`).
 //!
 //! The tree depends on the triangles only, never on the thread count: every split is decided by
 //! the same binned sweep, and subtrees built on other threads are spliced in a fixed order.
@@ -117,8 +118,8 @@ impl Bvh {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::bounds::Aabb;
-    use glam::Vec3A;
     use super::*;
+    use glam::Vec3A;
 
     /// A tree over unshared corners, as a triangle soup, and its positions.
     pub(crate) fn soup(tris: &[[Vec3A; 3]]) -> (Bvh, Vec<[f32; 3]>) {

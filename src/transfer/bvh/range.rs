@@ -118,12 +118,45 @@ impl Local {
 /// be: an item's side is a coin toss).
 fn partition(idx: &mut [u8], which: &[u8; LOCAL], k: usize) -> usize {
     let mut i = 0;
-    for j in 0..idx.len() {
-        let left = (which[j] as usize) < k;
+    for (j, &w) in which.iter().enumerate().take(idx.len()) {
+        let left = (w as usize) < k;
         let (a, b) = (idx[i], idx[j]);
         idx[i] = if left { b } else { a };
         idx[j] = if left { a } else { b };
         i += left as usize;
     }
     i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The branch-free partition leaves the order of the swaps it stands for.
+    #[test]
+    fn partition_as_the_swaps_leave() {
+        let mut x = 0x2545_f491u32;
+        for n in [1, 2, 17, 100, 256] {
+            for k in 0..=BINS {
+                let mut which = [0u8; LOCAL];
+                which.iter_mut().take(n).for_each(|w| {
+                    x ^= x << 13;
+                    x ^= x >> 17;
+                    x ^= x << 5;
+                    *w = (x % BINS as u32) as u8;
+                });
+                let mut want: Vec<u8> = (0..n).map(|i| i as u8).collect();
+                let mut i = 0;
+                for (j, &w) in which.iter().enumerate().take(n) {
+                    if (w as usize) < k {
+                        want.swap(i, j);
+                        i += 1;
+                    }
+                }
+                let mut got: Vec<u8> = (0..n).map(|i| i as u8).collect();
+                assert_eq!(partition(&mut got, &which, k), i);
+                assert_eq!(got, want, "{n} items, boundary {k}");
+            }
+        }
+    }
 }
