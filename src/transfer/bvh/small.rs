@@ -45,9 +45,9 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
         right[k] = acc.area() * (len - k) as f32;
     }
     let (mut acc, mut best) = (Aabb::EMPTY, (f32::INFINITY, 0, Aabb::EMPTY));
-    for k in 1..len {
+    for (k, &r) in right.iter().enumerate().take(len).skip(1) {
         acc.join(bounds(k - 1));
-        let cost = acc.area() * k as f32 + right[k];
+        let cost = acc.area() * k as f32 + r;
         if cost < best.0 {
             best = (cost, k, acc);
         }
