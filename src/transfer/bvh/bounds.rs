@@ -45,6 +45,13 @@ pub(super) struct Item {
 }
 
 impl Item {
+    /// Triangle `id`'s item, its corners `t` indices into `positions`.
+    pub fn of(positions: &[[f32; 3]], t: [u32; 3], id: u32) -> Item {
+        let mut b = Aabb::EMPTY;
+        t.iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
+        Item { min: b.min.to_array(), max: b.max.to_array(), id }
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb { min: Vec3A::from(self.min), max: Vec3A::from(self.max) }
     }

@@ -1,8 +1,9 @@
 //! A bounding-volume hierarchy over HIGH's triangles, four children to a node.
 //!
-//! Built in two steps: a binary tree by the surface area heuristic (`sah.rs`), its upper levels
-//! split at Morton-code boundaries on a large HIGH (`morton.rs`), then collapsed to the four-wide
-//! nodes the rays walk (`collapse.rs`; both node layouts in `node.rs`).
+//! Built in two steps: a binary tree by the surface area heuristic (`sah.rs`; ranges of up to 256
+//! triangles in `range.rs`, of up to 16 in `small.rs`), its upper levels split at Morton-code
+//! boundaries on a large HIGH (`morton.rs`), then collapsed to the four-wide nodes the rays walk
+//! (`collapse.rs`; both node layouts in `node.rs`).
 //!
 //! The tree depends on the triangles only, never on the thread count: every split is decided by
 //! the same binned sweep, and subtrees built on other threads are spliced in a fixed order.
@@ -14,11 +15,12 @@ mod bounds;
 mod collapse;
 mod morton;
 mod node;
+mod range;
 mod sah;
+mod small;
 
-use bounds::{bounds_of, Aabb, Item};
+use bounds::{bounds_of, Item};
 use collapse::Upper;
-use glam::Vec3A;
 pub use node::WideNode;
 
 /// Ranges smaller than this are built, bounded and binned on the current thread.
@@ -65,14 +67,8 @@ impl Bvh {
         if n == 0 {
             return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
         }
-        let mut items: Vec<Item> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let mut b = Aabb::EMPTY;
-                triangles[i].iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
-                Item { min: b.min.to_array(), max: b.max.to_array(), id: i as u32 }
-            })
-            .collect();
+        let mut items: Vec<Item> =
+            (0..n).into_par_iter().map(|i| Item::of(positions, triangles[i], i as u32)).collect();
         let bc = bounds_of(&items);
         let upper = if morton::applies(n) {
             morton::build(&mut items, &bc.1)
@@ -121,7 +117,9 @@ impl Bvh {
 
 #[cfg(test)]
 pub(crate) mod tests {
+    use super::bounds::Aabb;
     use super::*;
+    use glam::Vec3A;
 
     /// A tree over unshared corners, as a triangle soup, and its positions.
     pub(crate) fn soup(tris: &[[Vec3A; 3]]) -> (Bvh, Vec<[f32; 3]>) {

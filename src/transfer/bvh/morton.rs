@@ -11,6 +11,9 @@ use glam::Vec3A;
 /// From this many triangles on, the upper levels are split here rather than by SAH.
 pub(super) const MORTON_MIN: usize = 64 * 1024;
 const SAH_RANGE: usize = 256;
+/// Splits of fewer items build both sides on the current thread: tasks of a few dozen ranges
+/// each, not one a range.
+const SERIAL_BELOW: usize = 8 * 1024;
 /// A Morton key holds the code above a triangle's index, so keys are unique and sort alike on
 /// any thread count: 12 bits an axis over 28 bits of index (HIGHs up to 268M triangles).
 const INDEX_BITS: u32 = 28;
@@ -105,7 +108,11 @@ fn build_upper(items: &mut [Item], codes: &[u64], offset: usize) -> Upper {
     let mid = codes.partition_point(|c| c >> bit & 1 == 0);
     let (l, r) = items.split_at_mut(mid);
     let (cl, cr) = codes.split_at(mid);
-    let (left, right) = rayon::join(|| build_upper(l, cl, offset), || build_upper(r, cr, offset + mid));
+    let (left, right) = if codes.len() < SERIAL_BELOW {
+        (build_upper(l, cl, offset), build_upper(r, cr, offset + mid))
+    } else {
+        rayon::join(|| build_upper(l, cl, offset), || build_upper(r, cr, offset + mid))
+    };
     let mut b = upper_bounds(&left);
     b.join(&upper_bounds(&right));
     Upper::Split(Node::inner(&b, 0), Box::new(left), Box::new(right))

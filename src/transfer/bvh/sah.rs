@@ -7,17 +7,18 @@
 
 use super::bounds::{bounds_of, Aabb, Item};
 use super::node::Node;
+use super::range::{self, LOCAL};
 use super::PARALLEL_MIN;
 use glam::Vec3A;
 
-const BINS: usize = 16;
+pub(super) const BINS: usize = 16;
 /// The most triangles a leaf is made of by choice; ranges whose centres cannot be told apart
 /// end in leaves of up to twice this.
 pub(super) const MAX_LEAF: usize = 4;
 /// A node visit costed in triangle tests, for the leaf-or-split choice.
-const NODE_COST: f32 = 2.0;
-/// Ranges of at most this many triangles are split exactly, without bins ([`build_small`]).
-const SMALL: usize = 16;
+pub(super) const NODE_COST: f32 = 2.0;
+/// Ranges of at most this many triangles are split exactly, without bins (`small.rs`).
+pub(super) const SMALL: usize = 16;
 
 /// Builds the subtree over `items` (which start at `offset` in leaf order, with bounds and
 /// centre bounds `bc`); its root is node 0.
@@ -47,8 +48,8 @@ pub(super) fn build_par(items: &mut [Item], offset: usize, bc: (Aabb, Aabb)) -> 
 }
 
 fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, (b, c): (Aabb, Aabb)) {
-    if items.len() <= SMALL {
-        build_small(items, offset, nodes, b);
+    if items.len() <= LOCAL {
+        range::build(items, offset, nodes, (b, c));
         return;
     }
     let me = nodes.len();
@@ -67,64 +68,8 @@ fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, (b, c)
     build_serial(r, offset + mid, nodes, rb);
 }
 
-/// A range of at most [`SMALL`] triangles: the exact SAH split (each boundary between the
-/// centres sorted along their longest axis) and no bins, whose fixed cost (16 bins, two sweeps)
-/// dwarfed the work on so few items: 70% of the build's instructions went there.
-fn build_small(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, b: Aabb) {
-    let n = items.len();
-    if n == 1 {
-        nodes.push(Node::leaf(&b, offset, 1));
-        return;
-    }
-    let mut c = Aabb::EMPTY;
-    items.iter().for_each(|it| c.grow(it.centre()));
-    let axis = longest(c.max - c.min);
-    // Insertion sort of the keys, each computed once (a handful of items; `id` breaks ties so
-    // the order is the input's), then the items moved once.
-    let mut keys = [((0.0f32, 0u32), 0usize); SMALL];
-    for (i, (k, it)) in keys.iter_mut().zip(items.iter()).enumerate() {
-        *k = ((it.centre()[axis], it.id), i);
-    }
-    for i in 1..n {
-        let mut j = i;
-        while j > 0 && keys[j - 1].0 > keys[j].0 {
-            keys.swap(j - 1, j);
-            j -= 1;
-        }
-    }
-    let mut was = [items[0]; SMALL];
-    was[..n].copy_from_slice(items);
-    items.iter_mut().zip(&keys).for_each(|(it, &(_, i))| *it = was[i]);
-    let mut right = [(Aabb::EMPTY, 0.0f32); SMALL];
-    let mut acc = Aabb::EMPTY;
-    for k in (1..n).rev() {
-        acc.join(&items[k].bounds());
-        right[k] = (acc, acc.area() * (n - k) as f32);
-    }
-    let (mut acc, mut best) = (Aabb::EMPTY, (f32::INFINITY, 0, Aabb::EMPTY));
-    for k in 1..n {
-        acc.join(&items[k - 1].bounds());
-        let cost = acc.area() * k as f32 + right[k].1;
-        if cost < best.0 {
-            best = (cost, k, acc);
-        }
-    }
-    let (cost, k, lb) = best;
-    // As in `split`: a node visit costs two triangle tests.
-    if n <= MAX_LEAF && cost + NODE_COST * b.area() >= b.area() * n as f32 {
-        nodes.push(Node::leaf(&b, offset, n));
-        return;
-    }
-    let me = nodes.len();
-    nodes.push(Node::inner(&b, 0));
-    let (l, r) = items.split_at_mut(k);
-    build_small(l, offset, nodes, lb);
-    nodes[me].right_or_first = nodes.len() as u32;
-    build_small(r, offset + k, nodes, right[k].0);
-}
-
 /// Per bin: the items' bounds, their centres' bounds and their count.
-type Bins = [(Aabb, Aabb, usize); BINS];
+pub(super) type Bins = [(Aabb, Aabb, usize); BINS];
 
 /// The items binned by centre along `axis` (in parallel for a large range; the same bins in any
 /// grouping).
@@ -170,11 +115,11 @@ fn bins_bounds(bins: &Bins, r: std::ops::Range<usize>) -> (Aabb, Aabb) {
 
 /// A binned split: the axis, the boundary (items in bins below `bin` go left), and each side's
 /// bounds and centre bounds.
-struct Split {
-    axis: usize,
-    bin: usize,
-    left: (Aabb, Aabb),
-    right: (Aabb, Aabb),
+pub(super) struct Split {
+    pub axis: usize,
+    pub bin: usize,
+    pub left: (Aabb, Aabb),
+    pub right: (Aabb, Aabb),
 }
 
 /// The best binned-SAH split of `items` along the centres' longest axis, or `None` when a leaf
@@ -188,7 +133,12 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
     if e.is_nan() || e <= 0.0 {
         return None;
     }
-    let bins = bin(items, c, axis);
+    choose(&bin(items, c, axis), items.len(), b, axis)
+}
+
+/// The best boundary between `bins` (of `n` items with bounds `b`, binned along `axis`), or
+/// `None` when a leaf is cheaper.
+pub(super) fn choose(bins: &Bins, n: usize, b: &Aabb, axis: usize) -> Option<Split> {
     // Sweep from the right, then from the left: the cost of each boundary.
     let mut right_cost = [0.0f32; BINS];
     let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
@@ -202,7 +152,7 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
     for k in 1..BINS {
         acc.join(&bins[k - 1].0);
         cnt += bins[k - 1].2;
-        if cnt == 0 || cnt == items.len() {
+        if cnt == 0 || cnt == n {
             continue;
         }
         let cost = acc.area() * cnt as f32 + right_cost[k];
@@ -213,11 +163,11 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
     let (cost, k) = best?;
     // A node visit is costed as two triangle tests: on the benchmark's HIGH that gives 36% fewer
     // nodes and took about 6% less CPU than costing it as one (same map, bit for bit).
-    let leaf_cost = b.area() * items.len() as f32;
-    if items.len() <= MAX_LEAF && cost + NODE_COST * b.area() >= leaf_cost {
+    let leaf_cost = b.area() * n as f32;
+    if n <= MAX_LEAF && cost + NODE_COST * b.area() >= leaf_cost {
         return None;
     }
-    Some(Split { axis, bin: k, left: bins_bounds(&bins, 0..k), right: bins_bounds(&bins, k..BINS) })
+    Some(Split { axis, bin: k, left: bins_bounds(bins, 0..k), right: bins_bounds(bins, k..BINS) })
 }
 
 /// Moves the items left of bin boundary `k` on `axis` to the front; returns how many there are.
@@ -249,7 +199,7 @@ fn halves(items: &[Item]) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
 }
 
 /// The axis along which `e` is longest (x before y before z on ties).
-fn longest(e: Vec3A) -> usize {
+pub(super) fn longest(e: Vec3A) -> usize {
     if e.x >= e.y && e.x >= e.z {
         0
     } else if e.y >= e.z {
