@@ -1,7 +1,8 @@
 //! A bounding-volume hierarchy over HIGH's triangles, four children to a node.
 //!
 //! Built in two steps: a binary tree by the surface area heuristic (`sah.rs`; ranges of up to 256
-//! triangles in `range.rs`, of up to 16 in `small.rs`), its upper levels split at Morton-code
+//! triangles in `range.rs` on the copies `local.rs` makes, of up to 16 in `small.rs`; the cost
+//! model and the choice of a boundary, shared by the three, in `cost.rs`), its upper levels split at Morton-code
 //! boundaries on a large HIGH (`morton.rs`), then collapsed to the four-wide nodes the rays walk
 //! (`collapse.rs`; both node layouts in `node.rs`).
 //!
@@ -13,6 +14,8 @@
 
 mod bounds;
 mod collapse;
+mod cost;
+mod local;
 mod morton;
 mod node;
 mod range;
@@ -210,7 +213,7 @@ pub(crate) mod tests {
         let t = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
         let (bvh, _) = soup(&vec![t; 1000]);
         let counts = || bvh.nodes.iter().flat_map(|n| n.count);
-        assert!(counts().all(|c| c as usize <= sah::MAX_LEAF * 2));
+        assert!(counts().all(|c| c as usize <= cost::MAX_LEAF * 2));
         assert_eq!(counts().map(|c| c as usize).sum::<usize>(), 1000);
     }
 }

@@ -1,4 +1,4 @@
-//! A range of at most [`LOCAL`] triangles (every Morton range, and the bottom of every SAH
+//! A range of at most `LOCAL` (256) triangles (every Morton range, and the bottom of every SAH
 //! subtree), built on copies of its items' boxes and centres held by the builder: the splits move
 //! one-byte indices instead of 28-byte items, each centre is computed once instead of at every
 //! level, an item's bin is kept from the binning for the partition, and the partition moves its
@@ -6,41 +6,18 @@
 //! those of `sah.rs` exactly, and the partition leaves the same order as its swaps.
 
 use super::bounds::{Aabb, Item};
+use super::cost::{self, Bins, BINS, MAX_LEAF, SMALL};
+use super::local::{Local, LOCAL};
 use super::node::Node;
-use super::sah::{self, Bins, BINS, MAX_LEAF, SMALL};
 use super::small;
 use glam::Vec3A;
-
-/// The most items a range built here holds: an index fits a byte.
-pub(super) const LOCAL: usize = 256;
-
-/// The range's items as given, their boxes and their centres, by index.
-pub(super) struct Local {
-    pub was: [Item; LOCAL],
-    pub bounds: [Aabb; LOCAL],
-    pub centre: [Vec3A; LOCAL],
-    /// The centres by axis, for the binning: one load an item, along the axis split.
-    along: [[f32; LOCAL]; 3],
-}
 
 /// Builds the subtree over `items` (at most [`LOCAL`], starting at `offset` in leaf order, with
 /// bounds and centre bounds `bc`) into `nodes`, and leaves `items` in leaf order.
 pub(super) fn build(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, bc: (Aabb, Aabb)) {
     let n = items.len();
     debug_assert!((1..=LOCAL).contains(&n));
-    let mut l = Local {
-        was: [items[0]; LOCAL],
-        bounds: [Aabb::EMPTY; LOCAL],
-        centre: [Vec3A::ZERO; LOCAL],
-        along: [[0.0; LOCAL]; 3],
-    };
-    l.was[..n].copy_from_slice(items);
-    for (i, it) in items.iter().enumerate() {
-        l.bounds[i] = it.bounds();
-        let c = it.centre();
-        l.centre[i] = c;
-        (0..3).for_each(|a| l.along[a][i] = c[a]);
-    }
+    let l = Local::of(items);
     let mut idx = [0u8; LOCAL];
     idx.iter_mut().take(n).enumerate().for_each(|(i, x)| *x = i as u8);
     l.serial(&mut idx[..n], offset, nodes, bc);
@@ -73,9 +50,9 @@ impl Local {
     }
 
     /// As `sah::split`, with each item's bin (by its place in `idx`) for the partition.
-    fn split(&self, idx: &[u8], b: &Aabb, c: &Aabb) -> Option<(sah::Split, [u8; LOCAL])> {
+    fn split(&self, idx: &[u8], b: &Aabb, c: &Aabb) -> Option<(cost::Split, [u8; LOCAL])> {
         let extent = c.max - c.min;
-        let axis = sah::longest(extent);
+        let axis = cost::longest(extent);
         let e = extent[axis];
         if e.is_nan() || e <= 0.0 {
             return None;
@@ -94,7 +71,7 @@ impl Local {
             bins[k].2 += 1;
             *w = k as u8;
         }
-        sah::choose(&bins, idx.len(), b, axis).map(|sp| (sp, which))
+        cost::choose(&bins, idx.len(), b, axis).map(|sp| (sp, which))
     }
 
     /// As `sah::halves`: two halves of equal count (centres that cannot be told apart).

@@ -6,19 +6,11 @@
 //! node's first child is the node after it.
 
 use super::bounds::{bounds_of, Aabb, Item};
+use super::cost::{choose, longest, Bins, Split, BINS, MAX_LEAF};
+use super::local::LOCAL;
 use super::node::Node;
-use super::range::{self, LOCAL};
+use super::range;
 use super::PARALLEL_MIN;
-use glam::Vec3A;
-
-pub(super) const BINS: usize = 16;
-/// The most triangles a leaf is made of by choice; ranges whose centres cannot be told apart
-/// end in leaves of up to twice this.
-pub(super) const MAX_LEAF: usize = 4;
-/// A node visit costed in triangle tests, for the leaf-or-split choice.
-pub(super) const NODE_COST: f32 = 2.0;
-/// Ranges of at most this many triangles are split exactly, without bins (`small.rs`).
-pub(super) const SMALL: usize = 16;
 
 /// Builds the subtree over `items` (which start at `offset` in leaf order, with bounds and
 /// centre bounds `bc`); its root is node 0.
@@ -68,9 +60,6 @@ fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, (b, c)
     build_serial(r, offset + mid, nodes, rb);
 }
 
-/// Per bin: the items' bounds, their centres' bounds and their count.
-pub(super) type Bins = [(Aabb, Aabb, usize); BINS];
-
 /// The items binned by centre along `axis` (in parallel for a large range; the same bins in any
 /// grouping).
 fn bin(items: &[Item], c: &Aabb, axis: usize) -> Bins {
@@ -103,25 +92,6 @@ fn bin(items: &[Item], c: &Aabb, axis: usize) -> Bins {
     )
 }
 
-/// The bounds and centre bounds of bins `r`: a child's, with no pass over its items.
-fn bins_bounds(bins: &Bins, r: std::ops::Range<usize>) -> (Aabb, Aabb) {
-    let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
-    for x in &bins[r] {
-        b.join(&x.0);
-        c.join(&x.1);
-    }
-    (b, c)
-}
-
-/// A binned split: the axis, the boundary (items in bins below `bin` go left), and each side's
-/// bounds and centre bounds.
-pub(super) struct Split {
-    pub axis: usize,
-    pub bin: usize,
-    pub left: (Aabb, Aabb),
-    pub right: (Aabb, Aabb),
-}
-
 /// The best binned-SAH split of `items` along the centres' longest axis, or `None` when a leaf
 /// is cheaper or the centres cannot be told apart.
 fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
@@ -134,40 +104,6 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
         return None;
     }
     choose(&bin(items, c, axis), items.len(), b, axis)
-}
-
-/// The best boundary between `bins` (of `n` items with bounds `b`, binned along `axis`), or
-/// `None` when a leaf is cheaper.
-pub(super) fn choose(bins: &Bins, n: usize, b: &Aabb, axis: usize) -> Option<Split> {
-    // Sweep from the right, then from the left: the cost of each boundary.
-    let mut right_cost = [0.0f32; BINS];
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-    for k in (1..BINS).rev() {
-        acc.join(&bins[k].0);
-        cnt += bins[k].2;
-        right_cost[k] = acc.area() * cnt as f32;
-    }
-    let mut best: Option<(f32, usize)> = None;
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-    for k in 1..BINS {
-        acc.join(&bins[k - 1].0);
-        cnt += bins[k - 1].2;
-        if cnt == 0 || cnt == n {
-            continue;
-        }
-        let cost = acc.area() * cnt as f32 + right_cost[k];
-        if best.map(|(bc, _)| cost < bc).unwrap_or(true) {
-            best = Some((cost, k));
-        }
-    }
-    let (cost, k) = best?;
-    // A node visit is costed as two triangle tests: on the benchmark's HIGH that gives 36% fewer
-    // nodes and took about 6% less CPU than costing it as one (same map, bit for bit).
-    let leaf_cost = b.area() * n as f32;
-    if n <= MAX_LEAF && cost + NODE_COST * b.area() >= leaf_cost {
-        return None;
-    }
-    Some(Split { axis, bin: k, left: bins_bounds(bins, 0..k), right: bins_bounds(bins, k..BINS) })
 }
 
 /// Moves the items left of bin boundary `k` on `axis` to the front; returns how many there are.
@@ -196,15 +132,4 @@ fn divide(items: &mut [Item], b: &Aabb, c: &Aabb) -> (usize, (Aabb, Aabb), (Aabb
 fn halves(items: &[Item]) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
     let mid = items.len() / 2;
     (mid, bounds_of(&items[..mid]), bounds_of(&items[mid..]))
-}
-
-/// The axis along which `e` is longest (x before y before z on ties).
-pub(super) fn longest(e: Vec3A) -> usize {
-    if e.x >= e.y && e.x >= e.z {
-        0
-    } else if e.y >= e.z {
-        1
-    } else {
-        2
-    }
 }

@@ -5,9 +5,9 @@
 //! gives. The items are one-byte indices into the range's boxes and centres (`range.rs`).
 
 use super::bounds::Aabb;
+use super::cost::{longest, MAX_LEAF, NODE_COST, SMALL};
+use super::local::Local;
 use super::node::Node;
-use super::range::Local;
-use super::sah::{longest, MAX_LEAF, NODE_COST, SMALL};
 
 /// Builds the subtree over the items `idx` of `l` (at most [`SMALL`], starting at `offset` in
 /// leaf order, with bounds `b`) into `nodes`, and leaves `idx` in leaf order.
