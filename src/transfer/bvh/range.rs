@@ -10,7 +10,6 @@ use super::cost::{self, Bins, BINS, MAX_LEAF, SMALL};
 use super::local::{Local, LOCAL};
 use super::node::Node;
 use super::small;
-use glam::Vec3A;
 
 /// Builds the subtree over `items` (at most [`LOCAL`], starting at `offset` in leaf order, with
 /// bounds and centre bounds `bc`) into `nodes`, and leaves `items` in leaf order.
