@@ -14,25 +14,65 @@ pub(super) struct Local {
     pub centre: [Vec3A; LOCAL],
     /// The centres by axis, for the binning: one load an item, along the axis split.
     pub along: [[f32; LOCAL]; 3],
+    /// Per axis, the order the small-range split sorts by as one integer: the centre's bits made
+    /// to order as the floats do, above the item's id (which breaks ties as the input's order).
+    pub key: [[u64; LOCAL]; 3],
+}
+
+thread_local! {
+    /// One buffer a thread, filled anew for each range: 28 KB that a new one per range would
+    /// zero first (tens of thousands of ranges at 10M triangles).
+    static BUFFER: std::cell::RefCell<Box<Local>> = std::cell::RefCell::new(Box::new(Local {
+        was: [Item { min: [0.0; 3], max: [0.0; 3], id: 0 }; LOCAL],
+        bounds: [Aabb::EMPTY; LOCAL],
+        centre: [Vec3A::ZERO; LOCAL],
+        along: [[0.0; LOCAL]; 3],
+        key: [[0; LOCAL]; 3],
+    }));
 }
 
 impl Local {
-    /// The copies of `items` (1 to [`LOCAL`] of them).
-    pub fn of(items: &[Item]) -> Local {
-        let n = items.len();
-        let mut l = Local {
-            was: [items[0]; LOCAL],
-            bounds: [Aabb::EMPTY; LOCAL],
-            centre: [Vec3A::ZERO; LOCAL],
-            along: [[0.0; LOCAL]; 3],
-        };
-        l.was[..n].copy_from_slice(items);
-        for (i, it) in items.iter().enumerate() {
-            l.bounds[i] = it.bounds();
-            let c = it.centre();
-            l.centre[i] = c;
-            (0..3).for_each(|a| l.along[a][i] = c[a]);
+    /// Calls `f` with this thread's buffer holding the copies of `items` (1 to [`LOCAL`] of
+    /// them) in its first places, and the items.
+    pub fn with<R>(items: &mut [Item], f: impl FnOnce(&Local, &mut [Item]) -> R) -> R {
+        BUFFER.with(|b| {
+            let mut l = b.borrow_mut();
+            l.was[..items.len()].copy_from_slice(items);
+            for (i, it) in items.iter().enumerate() {
+                l.bounds[i] = it.bounds();
+                let c = it.centre();
+                l.centre[i] = c;
+                for a in 0..3 {
+                    l.along[a][i] = c[a];
+                    l.key[a][i] = u64::from(ordered(c[a])) << 32 | u64::from(it.id);
+                }
+            }
+            f(&l, items)
+        })
+    }
+}
+
+/// `x`'s bits as an integer that orders as the floats do (-0 as +0, so that they tie as floats).
+fn ordered(x: f32) -> u32 {
+    let b = (x + 0.0).to_bits();
+    if b >> 31 == 1 {
+        !b
+    } else {
+        b | 1 << 31
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ordered;
+
+    #[test]
+    fn ordered_as_the_floats() {
+        let xs = [f32::NEG_INFINITY, -3.5e30, -1.0, -1e-40, -0.0, 0.0, 1e-40, 0.5, 1.0, 7e20, f32::INFINITY];
+        for a in xs {
+            for b in xs {
+                assert_eq!(ordered(a).cmp(&ordered(b)), a.partial_cmp(&b).expect("no NaN"), "{a} {b}");
+            }
         }
-        l
     }
 }

@@ -55,7 +55,8 @@ fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
         })
         .collect();
     // One pass on the code's top 12 bits into buckets, then each bucket sorted on its own, on
-    // every core: the keys are unique, so any sort gives the one order.
+    // every core. The pass keeps the keys' order, by index, so a stable sort of a bucket on the
+    // code's 24 lower bits gives the order of the whole keys (which are unique).
     let top = |k: u64| (k >> (INDEX_BITS + 2 * AXIS_BITS)) as usize;
     let mut start = vec![0usize; (1 << AXIS_BITS) + 1];
     keys.iter().for_each(|&k| start[top(k) + 1] += 1);
@@ -77,8 +78,36 @@ fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
         buckets.push(b);
         rest = r;
     }
-    buckets.into_par_iter().for_each(|b| b.sort_unstable());
+    buckets.into_par_iter().for_each(radix_low);
     sorted
+}
+
+/// Sorts `keys` (of one top-12-bit bucket) stably on the code's lower 24 bits, in three passes of
+/// eight: linear in the keys, where a comparison sort took twice the time at 10M.
+fn radix_low(keys: &mut [u64]) {
+    const PASSES: usize = 3;
+    if keys.len() < 64 {
+        // A few keys: insertion by the whole key is the same order and cheaper than 768 counts.
+        keys.sort_unstable();
+        return;
+    }
+    let digit = |k: u64, p: usize| (k >> (INDEX_BITS as usize + 8 * p)) as usize & 0xff;
+    let mut count = [[0usize; 256]; PASSES];
+    for &k in keys.iter() {
+        (0..PASSES).for_each(|p| count[p][digit(k, p)] += 1);
+    }
+    let mut other = vec![0u64; keys.len()];
+    for (p, c) in count.iter().enumerate() {
+        let mut at = [0usize; 256];
+        (1..256).for_each(|d| at[d] = at[d - 1] + c[d - 1]);
+        let (from, to): (&[u64], &mut [u64]) = if p % 2 == 0 { (keys, &mut other) } else { (&other, keys) };
+        for &k in from {
+            let d = digit(k, p);
+            to[at[d]] = k;
+            at[d] += 1;
+        }
+    }
+    keys.copy_from_slice(&other);
 }
 
 /// The low 12 bits of `x`, two zero bits after each.
@@ -121,6 +150,28 @@ fn build_upper(items: &mut [Item], codes: &[u64], offset: usize) -> Upper {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The radix pass gives the comparison sort's order on a bucket whose keys come in index
+    /// order, as the bucket pass leaves them.
+    #[test]
+    fn radix_low_sorts_as_the_whole_key() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for n in [1, 63, 64, 1000, 5000] {
+            let mut keys: Vec<u64> = (0..n as u64)
+                .map(|i| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    // Few codes, so that many keys share one and their indices decide.
+                    (x % 97 << 5 | x % 3) << INDEX_BITS | i
+                })
+                .collect();
+            let mut want = keys.clone();
+            want.sort_unstable();
+            radix_low(&mut keys);
+            assert_eq!(keys, want, "{n} keys");
+        }
+    }
 
     #[test]
     fn spread_leaves_two_zero_bits_after_each() {

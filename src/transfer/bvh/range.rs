@@ -16,13 +16,14 @@ use super::small;
 pub(super) fn build(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, bc: (Aabb, Aabb)) {
     let n = items.len();
     debug_assert!((1..=LOCAL).contains(&n));
-    let l = Local::of(items);
     let mut idx = [0u8; LOCAL];
     idx.iter_mut().take(n).enumerate().for_each(|(i, x)| *x = i as u8);
-    l.serial(&mut idx[..n], offset, nodes, bc);
-    for (it, &i) in items.iter_mut().zip(&idx[..n]) {
-        *it = l.was[i as usize];
-    }
+    Local::with(items, |l, items| {
+        l.serial(&mut idx[..n], offset, nodes, bc);
+        for (it, &i) in items.iter_mut().zip(&idx[..n]) {
+            *it = l.was[i as usize];
+        }
+    });
 }
 
 impl Local {

@@ -27,45 +27,54 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
     idx.iter().for_each(|&i| c.grow(l.centre[i as usize]));
     let axis = longest(c.max - c.min);
     if sorted != Some(axis) {
-        // Insertion sort: a handful of items; `id` breaks ties so the order is the input's.
-        let key = |i: u8| (l.centre[i as usize][axis], l.was[i as usize].id);
+        // Insertion sort: a handful of items; the key's id breaks ties as the input's order.
+        let key = &l.key[axis];
         for i in 1..len {
+            let (x, kx) = (idx[i], key[idx[i] as usize]);
             let mut j = i;
-            while j > 0 && key(idx[j - 1]) > key(idx[j]) {
-                idx.swap(j - 1, j);
+            while j > 0 && key[idx[j - 1] as usize] > kx {
+                idx[j] = idx[j - 1];
                 j -= 1;
             }
+            idx[j] = x;
         }
     }
+    // Two triangles always make a leaf: splitting costs the node visit (`NODE_COST`, two
+    // triangle tests) on top of each side's one.
+    if len == 2 && NODE_COST >= 2.0 {
+        nodes.push(Node::leaf(&b, offset, len));
+        return;
+    }
+    // Both sweeps in one loop, for two chains of joins the core runs side by side: `left[k]` and
+    // `right[k]` are the boxes of the items before and from place `k`.
     let bounds = |k: usize| &l.bounds[idx[k] as usize];
-    let mut right = [0.0f32; SMALL];
-    let mut acc = Aabb::EMPTY;
-    for k in (1..len).rev() {
-        acc.join(bounds(k));
-        right[k] = acc.area() * (len - k) as f32;
+    let (mut left, mut right) = ([Aabb::EMPTY; SMALL], [Aabb::EMPTY; SMALL]);
+    let (mut la, mut ra) = ([0.0f32; SMALL], [0.0f32; SMALL]);
+    let (mut accl, mut accr) = (Aabb::EMPTY, Aabb::EMPTY);
+    for t in 1..len {
+        accl.join(bounds(t - 1));
+        left[t] = accl;
+        la[t] = accl.area() * t as f32;
+        accr.join(bounds(len - t));
+        right[len - t] = accr;
+        ra[len - t] = accr.area() * t as f32;
     }
-    let (mut acc, mut best) = (Aabb::EMPTY, (f32::INFINITY, 0, Aabb::EMPTY));
-    for (k, &r) in right.iter().enumerate().take(len).skip(1) {
-        acc.join(bounds(k - 1));
-        let cost = acc.area() * k as f32 + r;
+    let mut best = (f32::INFINITY, 0);
+    for k in 1..len {
+        let cost = la[k] + ra[k];
         if cost < best.0 {
-            best = (cost, k, acc);
+            best = (cost, k);
         }
     }
-    let (cost, k, lb) = best;
+    let (cost, k) = best;
     // As in `sah::split`: a node visit costs two triangle tests.
     if len <= MAX_LEAF && cost + NODE_COST * b.area() >= b.area() * len as f32 {
         nodes.push(Node::leaf(&b, offset, len));
         return;
     }
-    let join = |s: &[u8]| {
-        let mut a = Aabb::EMPTY;
-        s.iter().for_each(|&i| a.join(&l.bounds[i as usize]));
-        a
-    };
     // No finite cost (boxes too large for f32 areas): halves.
-    let (k, lb) = if k == 0 { (len / 2, join(&idx[..len / 2])) } else { (k, lb) };
-    let rb = join(&idx[k..]);
+    let k = if k == 0 { len / 2 } else { k };
+    let (lb, rb) = (left[k], right[k]);
     let me = nodes.len();
     nodes.push(Node::inner(&b, 0));
     let (lo, hi) = idx.split_at_mut(k);
