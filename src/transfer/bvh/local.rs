@@ -32,23 +32,22 @@ thread_local! {
 }
 
 impl Local {
-    /// Calls `f` with this thread's buffer holding the copies of `items` (1 to [`LOCAL`] of
-    /// them) in its first places, and the items.
-    pub fn with<R>(items: &mut [Item], f: impl FnOnce(&Local, &mut [Item]) -> R) -> R {
-        BUFFER.with(|b| {
-            let mut l = b.borrow_mut();
-            l.was[..items.len()].copy_from_slice(items);
-            for (i, it) in items.iter().enumerate() {
-                l.bounds[i] = it.bounds();
-                let c = it.centre();
-                l.centre[i] = c;
-                for a in 0..3 {
-                    l.along[a][i] = c[a];
-                    l.key[a][i] = u64::from(ordered(c[a])) << 32 | u64::from(it.id);
-                }
-            }
-            f(&l, items)
-        })
+    /// Calls `f` with this thread's buffer, to be filled by [`Local::set`].
+    pub fn with<R>(f: impl FnOnce(&mut Local) -> R) -> R {
+        BUFFER.with(|b| f(&mut b.borrow_mut()))
+    }
+
+    /// Copies `it` into place `i`, with its box, centre and sort keys.
+    #[inline]
+    pub fn set(&mut self, i: usize, it: Item) {
+        self.was[i] = it;
+        self.bounds[i] = it.bounds();
+        let c = it.centre();
+        self.centre[i] = c;
+        for a in 0..3 {
+            self.along[a][i] = c[a];
+            self.key[a][i] = u64::from(ordered(c[a])) << 32 | u64::from(it.id);
+        }
     }
 }
 

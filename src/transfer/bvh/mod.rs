@@ -73,14 +73,14 @@ impl Bvh {
         let mut items: Vec<Item> =
             (0..n).into_par_iter().map(|i| Item::of(positions, triangles[i], i as u32)).collect();
         let bc = bounds_of(&items);
-        let upper = if morton::applies(n) {
-            morton::build(&mut items, &bc.1)
+        let (upper, ids) = if morton::applies(n) {
+            morton::build(&items, &bc.1)
         } else {
-            Upper::range(sah::build_par(&mut items, 0, bc))
+            let upper = Upper::range(sah::build_par(&mut items, 0, bc));
+            (upper, items.par_iter().map(|it| it.id).collect())
         };
         // Each array is dropped as soon as the next is made from it: the build's peak is what
         // bounds memory on a large HIGH.
-        let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         drop(items);
         let nodes = upper.collapse();
         let tris = ids

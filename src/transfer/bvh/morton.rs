@@ -4,7 +4,9 @@
 
 use super::bounds::{bounds_of, Aabb, Item};
 use super::collapse::Upper;
+use super::local::LOCAL;
 use super::node::Node;
+use super::range;
 use super::sah;
 use glam::Vec3A;
 
@@ -26,15 +28,16 @@ pub(super) fn applies(n: usize) -> bool {
     (MORTON_MIN..1 << INDEX_BITS).contains(&n)
 }
 
-/// Sorts `items` by the Morton code of their centres within `centres` (their centres' bounds)
-/// and builds the tree over them.
-pub(super) fn build(items: &mut Vec<Item>, centres: &Aabb) -> Upper {
+/// Builds the tree over `items` in the order of the Morton codes of their centres within
+/// `centres` (their centres' bounds); returns it and the items' ids in leaf order. The items are
+/// never gathered into that order: each range reads its own where they are.
+pub(super) fn build(items: &[Item], centres: &Aabb) -> (Upper, Vec<u32>) {
     use rayon::prelude::*;
     let mut keys = morton_keys(items, centres);
-    let sorted: Vec<Item> = keys.par_iter().map(|k| items[(k & INDEX_MASK) as usize]).collect();
-    *items = sorted;
-    keys.iter_mut().for_each(|k| *k >>= INDEX_BITS);
-    build_upper(items, &keys, 0)
+    let upper = build_upper(items, &mut keys, 0);
+    // Each range has left its ids in leaf order where its keys were.
+    let ids = keys.par_iter().map(|&k| k as u32).collect();
+    (upper, ids)
 }
 
 /// Each item's key (Morton code of its box's centre over the centres' bounds `c`, then its
@@ -125,26 +128,43 @@ fn upper_bounds(u: &Upper) -> Aabb {
     Aabb { min: Vec3A::from(n.min), max: Vec3A::from(n.max) }
 }
 
-/// The upper levels over Morton-sorted items: each split where the codes' highest differing
-/// bit flips; ranges of [`SAH_RANGE`] or fewer (or of one code) are built by binned SAH.
-fn build_upper(items: &mut [Item], codes: &[u64], offset: usize) -> Upper {
-    let last = codes.len() - 1;
-    if items.len() <= SAH_RANGE || codes[0] == codes[last] {
-        let bc = bounds_of(items);
-        return Upper::range(sah::build_par(items, offset, bc));
+/// The upper levels over the items `keys` names (sorted, each a code above an index into
+/// `items`): each split where the codes' highest differing bit flips; ranges of [`SAH_RANGE`] or
+/// fewer (or of one code) are built by binned SAH. Leaves each key holding its item's id, in leaf
+/// order.
+fn build_upper(items: &[Item], keys: &mut [u64], offset: usize) -> Upper {
+    let code = |k: u64| k >> INDEX_BITS;
+    let (first, last) = (code(keys[0]), code(keys[keys.len() - 1]));
+    if keys.len() <= SAH_RANGE || first == last {
+        return Upper::range(range(items, keys, offset));
     }
-    let bit = 63 - (codes[0] ^ codes[last]).leading_zeros();
-    let mid = codes.partition_point(|c| c >> bit & 1 == 0);
-    let (l, r) = items.split_at_mut(mid);
-    let (cl, cr) = codes.split_at(mid);
-    let (left, right) = if codes.len() < SERIAL_BELOW {
-        (build_upper(l, cl, offset), build_upper(r, cr, offset + mid))
+    let bit = 63 - (first ^ last).leading_zeros();
+    let mid = keys.partition_point(|&k| code(k) >> bit & 1 == 0);
+    let (l, r) = keys.split_at_mut(mid);
+    let (left, right) = if l.len() + r.len() < SERIAL_BELOW {
+        (build_upper(items, l, offset), build_upper(items, r, offset + mid))
     } else {
-        rayon::join(|| build_upper(l, cl, offset), || build_upper(r, cr, offset + mid))
+        rayon::join(|| build_upper(items, l, offset), || build_upper(items, r, offset + mid))
     };
     let mut b = upper_bounds(&left);
     b.join(&upper_bounds(&right));
     Upper::Split(Node::inner(&b, 0), Box::new(left), Box::new(right))
+}
+
+/// The binary tree over the range of items `keys` names, starting at `offset` in leaf order.
+fn range(items: &[Item], keys: &mut [u64], offset: usize) -> Vec<Node> {
+    keys.iter_mut().for_each(|k| *k &= INDEX_MASK);
+    let mut nodes = Vec::with_capacity(keys.len() / 2 + 1);
+    if keys.len() <= LOCAL {
+        range::build_by_index(items, keys, offset, &mut nodes);
+        return nodes;
+    }
+    // Many items with one code (a pile of duplicates): gathered, then split by count.
+    let mut gathered: Vec<Item> = keys.iter().map(|&k| items[k as usize]).collect();
+    let bc = bounds_of(&gathered);
+    let nodes = sah::build_par(&mut gathered, offset, bc);
+    keys.iter_mut().zip(&gathered).for_each(|(k, it)| *k = u64::from(it.id));
+    nodes
 }
 
 #[cfg(test)]

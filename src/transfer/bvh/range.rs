@@ -14,19 +14,43 @@ use super::small;
 /// Builds the subtree over `items` (at most [`LOCAL`], starting at `offset` in leaf order, with
 /// bounds and centre bounds `bc`) into `nodes`, and leaves `items` in leaf order.
 pub(super) fn build(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, bc: (Aabb, Aabb)) {
-    let n = items.len();
-    debug_assert!((1..=LOCAL).contains(&n));
-    let mut idx = [0u8; LOCAL];
-    idx.iter_mut().take(n).enumerate().for_each(|(i, x)| *x = i as u8);
-    Local::with(items, |l, items| {
-        l.serial(&mut idx[..n], offset, nodes, bc);
-        for (it, &i) in items.iter_mut().zip(&idx[..n]) {
+    debug_assert!((1..=LOCAL).contains(&items.len()));
+    Local::with(|l| {
+        items.iter().enumerate().for_each(|(i, &it)| l.set(i, it));
+        let idx = l.run(items.len(), offset, nodes, bc);
+        for (it, &i) in items.iter_mut().zip(&idx) {
             *it = l.was[i as usize];
         }
     });
 }
 
+/// [`build`] over the items `all[k]` for each `k` in `ids` (at most [`LOCAL`]), read where they
+/// are rather than gathered first; leaves `ids` holding the items' ids in leaf order.
+pub(super) fn build_by_index(all: &[Item], ids: &mut [u64], offset: usize, nodes: &mut Vec<Node>) {
+    debug_assert!((1..=LOCAL).contains(&ids.len()));
+    Local::with(|l| {
+        let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
+        for (i, &k) in ids.iter().enumerate() {
+            l.set(i, all[k as usize]);
+            b.join(&l.bounds[i]);
+            c.grow(l.centre[i]);
+        }
+        let idx = l.run(ids.len(), offset, nodes, (b, c));
+        for (x, &i) in ids.iter_mut().zip(&idx) {
+            *x = u64::from(l.was[i as usize].id);
+        }
+    });
+}
+
 impl Local {
+    /// Builds the subtree over the first `n` places; returns them in leaf order.
+    fn run(&self, n: usize, offset: usize, nodes: &mut Vec<Node>, bc: (Aabb, Aabb)) -> [u8; LOCAL] {
+        let mut idx = [0u8; LOCAL];
+        idx.iter_mut().take(n).enumerate().for_each(|(i, x)| *x = i as u8);
+        self.serial(&mut idx[..n], offset, nodes, bc);
+        idx
+    }
+
     /// As `sah::build_serial`, over the items `idx`, which it leaves in leaf order.
     fn serial(&self, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, (b, c): (Aabb, Aabb)) {
         if idx.len() <= SMALL {
