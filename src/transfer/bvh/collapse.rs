@@ -34,22 +34,28 @@ fn leaf_count(n: &Node) -> u8 {
 /// Opening the largest first keeps the children the rays are likeliest to enter in one node.
 fn open<T: Copy>(l: T, r: T, inner: impl Fn(T) -> Option<(f32, T, T)>) -> ([T; 4], usize) {
     let mut kids = [l, r, r, r];
+    // Each child's `inner`, asked once: a child stays in the node until it is opened.
+    let mut info = [inner(l), inner(r), None, None];
     let mut len = 2;
     while len < 4 {
-        let mut pick: Option<(usize, f32, T, T)> = None;
-        for (i, &k) in kids[..len].iter().enumerate() {
-            if let Some((area, a, b)) = inner(k) {
+        let mut pick: Option<(usize, f32)> = None;
+        for (i, k) in info[..len].iter().enumerate() {
+            if let Some((area, ..)) = *k {
                 if pick.is_none_or(|p| area > p.1) {
-                    pick = Some((i, area, a, b));
+                    pick = Some((i, area));
                 }
             }
         }
-        let Some((i, _, a, b)) = pick else { break };
+        let Some((i, _)) = pick else { break };
+        let Some((_, a, b)) = info[i] else { break };
         // The opened child's two children take its place, in order, so the lanes stay in the
         // binary tree's left-to-right order.
         kids.copy_within(i + 1..len, i + 2);
+        info.copy_within(i + 1..len, i + 2);
         kids[i] = a;
         kids[i + 1] = b;
+        info[i] = inner(a);
+        info[i + 1] = inner(b);
         len += 1;
     }
     (kids, len)
@@ -123,17 +129,27 @@ impl Upper {
         }
         let total = *starts.last().expect("starts at 0");
         out.reserve_exact(total);
-        out.par_extend((0..total).into_par_iter().map(|i| {
-            let r = starts.partition_point(|&s| s <= i) - 1;
-            let mut n = later[r].2[i - starts[r]];
-            let at = (base + starts[r]) as u32;
-            for k in 0..4 {
-                if n.has(k) && !n.is_leaf(k) {
-                    n.child[k] += at;
+        // Each task walks its indices upwards, so the range holding index `i` is found by one
+        // search per task and then by stepping on.
+        out.par_extend((0..total).into_par_iter().map_init(
+            || usize::MAX,
+            |r, i| {
+                if *r == usize::MAX || i < starts[*r] {
+                    *r = starts.partition_point(|&s| s <= i) - 1;
                 }
-            }
-            n
-        }));
+                while i >= starts[*r + 1] {
+                    *r += 1;
+                }
+                let mut n = later[*r].2[i - starts[*r]];
+                let at = (base + starts[*r]) as u32;
+                for k in 0..4 {
+                    if n.has(k) && !n.is_leaf(k) {
+                        n.child[k] += at;
+                    }
+                }
+                n
+            },
+        ));
         out
     }
 }
