@@ -90,7 +90,8 @@ fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
 fn radix_low(keys: &mut [u64]) {
     const PASSES: usize = 3;
     if keys.len() < 64 {
-        // A few keys: insertion by the whole key is the same order and cheaper than 768 counts.
+        // A few keys: a comparison sort of the whole keys gives the same order for less than
+        // three passes over 768 counts.
         keys.sort_unstable();
         return;
     }
