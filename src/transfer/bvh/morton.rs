@@ -21,6 +21,12 @@ const SERIAL_BELOW: usize = 8 * 1024;
 const INDEX_BITS: u32 = 28;
 const INDEX_MASK: u64 = (1 << INDEX_BITS) - 1;
 const AXIS_BITS: u32 = 12;
+/// The code's bits below the bucket pass's 8, sorted within each bucket in passes of 7.
+const LOW_BITS: u32 = 3 * AXIS_BITS - 8;
+const DIGIT_BITS: u32 = 7;
+const BUCKETS: usize = 1 << (3 * AXIS_BITS - LOW_BITS);
+/// The bucket pass's chunks: a fixed count, so that the work splits alike on any thread count.
+const CHUNKS: usize = 16;
 
 /// Whether a tree over `n` triangles gets Morton-split upper levels: enough of them that a
 /// pass over all per level costs more than the sort, few enough that an index fits its key.
@@ -57,27 +63,48 @@ fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
             code << INDEX_BITS | i as u64
         })
         .collect();
-    // One pass on the code's top 12 bits into buckets, then each bucket sorted on its own, on
-    // every core. The pass keeps the keys' order, by index, so a stable sort of a bucket on the
-    // code's 24 lower bits gives the order of the whole keys (which are unique).
-    let top = |k: u64| (k >> (INDEX_BITS + 2 * AXIS_BITS)) as usize;
-    let mut start = vec![0usize; (1 << AXIS_BITS) + 1];
-    keys.iter().for_each(|&k| start[top(k) + 1] += 1);
-    for d in 1..start.len() {
-        start[d] += start[d - 1];
-    }
+    // One pass on the code's top bits into buckets, then each bucket sorted on its own, on every
+    // core. The pass keeps the keys' order, by index, so a stable sort of a bucket on the code's
+    // lower bits gives the order of the whole keys (which are unique). The pass runs on every
+    // core too: each chunk of the keys writes its share of every bucket into a slice of its own,
+    // after the earlier chunks' shares, so the order is the same on any thread count. 256
+    // buckets, not more: the pass writes to as many places at once, and with 4096 it took 0.94 s
+    // at 50M (a page and a cache line missed for nearly every key), ten times its share at 10M.
+    let top = |k: u64| (k >> (INDEX_BITS + LOW_BITS)) as usize;
+    let chunk = n.div_ceil(CHUNKS).max(1);
+    let counts: Vec<[usize; BUCKETS]> = keys
+        .par_chunks(chunk)
+        .map(|ks| {
+            let mut h = [0usize; BUCKETS];
+            ks.iter().for_each(|&k| h[top(k)] += 1);
+            h
+        })
+        .collect();
     let mut sorted = vec![0u64; n];
-    let mut next = start.clone();
-    for &k in &keys {
-        let d = top(k);
-        sorted[next[d]] = k;
-        next[d] += 1;
-    }
-    drop(keys);
-    let mut buckets: Vec<&mut [u64]> = Vec::with_capacity(1 << AXIS_BITS);
+    let mut shares: Vec<Vec<&mut [u64]>> = counts.iter().map(|_| Vec::with_capacity(BUCKETS)).collect();
+    let mut sizes = [0usize; BUCKETS];
     let mut rest = sorted.as_mut_slice();
-    for d in 0..1 << AXIS_BITS {
-        let (b, r) = rest.split_at_mut(start[d + 1] - start[d]);
+    for (d, size) in sizes.iter_mut().enumerate() {
+        for (h, s) in counts.iter().zip(shares.iter_mut()) {
+            let (share, r) = rest.split_at_mut(h[d]);
+            s.push(share);
+            rest = r;
+            *size += h[d];
+        }
+    }
+    keys.par_chunks(chunk).zip(shares).for_each(|(ks, mut s)| {
+        let mut at = [0usize; BUCKETS];
+        for &k in ks {
+            let d = top(k);
+            s[d][at[d]] = k;
+            at[d] += 1;
+        }
+    });
+    drop(keys);
+    let mut buckets: Vec<&mut [u64]> = Vec::with_capacity(BUCKETS);
+    let mut rest = sorted.as_mut_slice();
+    for size in sizes {
+        let (b, r) = rest.split_at_mut(size);
         buckets.push(b);
         rest = r;
     }
@@ -85,25 +112,26 @@ fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
     sorted
 }
 
-/// Sorts `keys` (of one top-12-bit bucket) stably on the code's lower 24 bits, in three passes of
-/// eight: linear in the keys, where a comparison sort took twice the time at 10M.
+/// Sorts `keys` (of one bucket) stably on the code's lower [`LOW_BITS`] bits, in passes of
+/// [`DIGIT_BITS`]: linear in the keys, where a comparison sort took twice the time at 10M.
 fn radix_low(keys: &mut [u64]) {
-    const PASSES: usize = 3;
+    const PASSES: usize = (LOW_BITS / DIGIT_BITS) as usize;
+    const DIGITS: usize = 1 << DIGIT_BITS;
     if keys.len() < 64 {
         // A few keys: a comparison sort of the whole keys gives the same order for less than
-        // three passes over 768 counts.
+        // the passes' counts.
         keys.sort_unstable();
         return;
     }
-    let digit = |k: u64, p: usize| (k >> (INDEX_BITS as usize + 8 * p)) as usize & 0xff;
-    let mut count = [[0usize; 256]; PASSES];
+    let digit = |k: u64, p: usize| (k >> (INDEX_BITS as usize + DIGIT_BITS as usize * p)) as usize & (DIGITS - 1);
+    let mut count = [[0usize; DIGITS]; PASSES];
     for &k in keys.iter() {
         (0..PASSES).for_each(|p| count[p][digit(k, p)] += 1);
     }
     let mut other = vec![0u64; keys.len()];
     for (p, c) in count.iter().enumerate() {
-        let mut at = [0usize; 256];
-        (1..256).for_each(|d| at[d] = at[d - 1] + c[d - 1]);
+        let mut at = [0usize; DIGITS];
+        (1..DIGITS).for_each(|d| at[d] = at[d - 1] + c[d - 1]);
         let (from, to): (&[u64], &mut [u64]) = if p % 2 == 0 { (keys, &mut other) } else { (&other, keys) };
         for &k in from {
             let d = digit(k, p);
@@ -111,7 +139,9 @@ fn radix_low(keys: &mut [u64]) {
             at[d] += 1;
         }
     }
-    keys.copy_from_slice(&other);
+    if PASSES % 2 == 1 {
+        keys.copy_from_slice(&other);
+    }
 }
 
 /// The low 12 bits of `x`, two zero bits after each.
