@@ -174,6 +174,50 @@ fn height_plane(addr: usize, dtype: &str, width: usize, rows: usize) -> Option<H
     Some(HeightPlane::new(width, rows, data))
 }
 
+/// What both height-map calls are given besides the map, checked: the names as the library's
+/// values, and the samples finite.
+struct HeightArgs {
+    filter: Filter,
+    wrap: Wrap,
+    convention: Convention,
+    depth: Depth,
+    plane: HeightPlane,
+}
+
+impl HeightArgs {
+    fn read(
+        py: Python<'_>,
+        (height, dtype, width, rows): (usize, &str, usize, usize),
+        filter: &str,
+        wrap: &str,
+        convention: &str,
+        bits: u32,
+    ) -> PyResult<HeightArgs> {
+        let usage = |what: &str, v: &str| raise(py, Kind::Usage, format!("{what}={v:?} is not one of bumpbake's"));
+        let filter = named(&Filter::ALL, filter).ok_or_else(|| usage("filter", filter))?;
+        let wrap = named(&[Wrap::Repeat, Wrap::Clamp, Wrap::Mirror], wrap).ok_or_else(|| usage("wrap", wrap))?;
+        let convention = named(&[Convention::Opengl, Convention::Directx], convention)
+            .ok_or_else(|| usage("convention", convention))?;
+        let depth = match bits {
+            8 => Depth::Bits8,
+            16 => Depth::Bits16,
+            32 => Depth::Float,
+            _ => return Err(usage("bits", &bits.to_string())),
+        };
+        let plane = height_plane(height, dtype, width, rows).ok_or_else(|| usage("height.dtype", dtype))?;
+        if let Some(i) = plane.data.iter().position(|v| !v.is_finite()) {
+            let msg = format!(
+                "height[{}, {}] is {}: a height map's samples must be finite",
+                i / width,
+                i % width,
+                plane.data[i]
+            );
+            return Err(raise(py, Kind::Input, msg));
+        }
+        Ok(HeightArgs { filter, wrap, convention, depth, plane })
+    }
+}
+
 /// A tangent-space normal map of a height array, encoded as the command line writes it, into
 /// `out` (`rows` x `width` x channels of uint8, uint16 or float32 for `bits` 8, 16, 32).
 /// Returns the report (the flatness warning; with `report`, the steepest slope) as JSON.
@@ -198,23 +242,8 @@ pub fn normalmap(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     crate::errors::speak_keywords();
-    let usage = |what: &str, v: &str| raise(py, Kind::Usage, format!("{what}={v:?} is not one of bumpbake's"));
-    let filter = named(&Filter::ALL, filter).ok_or_else(|| usage("filter", filter))?;
-    let wrap = named(&[Wrap::Repeat, Wrap::Clamp, Wrap::Mirror], wrap).ok_or_else(|| usage("wrap", wrap))?;
-    let convention =
-        named(&[Convention::Opengl, Convention::Directx], convention).ok_or_else(|| usage("convention", convention))?;
-    let depth = match bits {
-        8 => Depth::Bits8,
-        16 => Depth::Bits16,
-        32 => Depth::Float,
-        _ => return Err(usage("bits", &bits.to_string())),
-    };
-    let plane = height_plane(height, dtype, width, rows).ok_or_else(|| usage("height.dtype", dtype))?;
-    if let Some(i) = plane.data.iter().position(|v| !v.is_finite()) {
-        let msg =
-            format!("height[{}, {}] is {}: a height map's samples must be finite", i / width, i % width, plane.data[i]);
-        return Err(raise(py, Kind::Input, msg));
-    }
+    let HeightArgs { filter, wrap, convention, depth, plane } =
+        HeightArgs::read(py, (height, dtype, width, rows), filter, wrap, convention, bits)?;
     let opts = Options { strength, filter, wrap, invert };
     let channels = if alpha { 4 } else { 3 };
     let n = width * rows * channels;
@@ -314,23 +343,8 @@ pub fn bump_to_normal(
 ) -> PyResult<String> {
     use bumpbake::bake::surface::{surface_normals, Bump, SurfaceMesh};
     crate::errors::speak_keywords();
-    let usage = |what: &str, v: &str| raise(py, Kind::Usage, format!("{what}={v:?} is not one of bumpbake's"));
-    let filter = named(&Filter::ALL, filter).ok_or_else(|| usage("filter", filter))?;
-    let wrap = named(&[Wrap::Repeat, Wrap::Clamp, Wrap::Mirror], wrap).ok_or_else(|| usage("wrap", wrap))?;
-    let convention =
-        named(&[Convention::Opengl, Convention::Directx], convention).ok_or_else(|| usage("convention", convention))?;
-    let depth = match bits {
-        8 => Depth::Bits8,
-        16 => Depth::Bits16,
-        32 => Depth::Float,
-        _ => return Err(usage("bits", &bits.to_string())),
-    };
-    let plane = height_plane(height, dtype, width, rows).ok_or_else(|| usage("height.dtype", dtype))?;
-    if let Some(i) = plane.data.iter().position(|v| !v.is_finite()) {
-        let msg =
-            format!("height[{}, {}] is {}: a height map's samples must be finite", i / width, i % width, plane.data[i]);
-        return Err(raise(py, Kind::Input, msg));
-    }
+    let HeightArgs { filter, wrap, convention, depth, plane } =
+        HeightArgs::read(py, (height, dtype, width, rows), filter, wrap, convention, bits)?;
     // SAFETY: per-corner arrays the Python side checked and holds, `corners` rows each.
     let (positions, normals, tangents, uvs) = unsafe {
         (
