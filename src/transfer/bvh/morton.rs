@@ -214,7 +214,7 @@ mod tests {
                     x ^= x >> 7;
                     x ^= x << 17;
                     // Few codes, so that many keys share one and their indices decide.
-                    (x % 97 << 5 | x % 3) << INDEX_BITS | i
+                    (((x % 97) << 5) | (x % 3)) << INDEX_BITS | i
                 })
                 .collect();
             let mut want = keys.clone();
