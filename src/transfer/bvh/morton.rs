@@ -224,6 +224,35 @@ mod tests {
         }
     }
 
+    /// The bucket pass and the radix passes give the keys in sorted order, whatever the
+    /// thread count (items spread unevenly, many sharing a cell).
+    #[test]
+    fn keys_come_sorted() {
+        use super::super::bounds::bounds_of;
+        let mut x = 0x2545_f491u32;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x % 10_000) as f32 / 10_000.0
+        };
+        let items: Vec<Item> = (0..50_000u32)
+            .map(|id| {
+                let p = [next().powi(3), next(), (next() * 8.0).floor() / 8.0];
+                Item { min: p, max: p.map(|v| v + 0.001), id }
+            })
+            .collect();
+        let (_, c) = bounds_of(&items);
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+        let keys = one.install(|| morton_keys(&items, &c));
+        assert!(keys.windows(2).all(|w| w[0] < w[1]));
+        let mut ids: Vec<u64> = keys.iter().map(|k| k & INDEX_MASK).collect();
+        ids.sort_unstable();
+        assert!(ids.iter().enumerate().all(|(i, &k)| k == i as u64), "every item once");
+        let three = rayon::ThreadPoolBuilder::new().num_threads(3).build().expect("pool");
+        assert_eq!(three.install(|| morton_keys(&items, &c)), keys);
+    }
+
     #[test]
     fn spread_leaves_two_zero_bits_after_each() {
         for x in [0u64, 1, 0b101, 0xfff, 0xabc] {
