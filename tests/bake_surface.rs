@@ -73,6 +73,12 @@ fn errors(map: &[[f64; 3]], d: f64, sx: f64, sy: f64) -> (f64, f64) {
     (sum / (W * H) as f64, max)
 }
 
+/// `bake OBJ --height HEIGHT --height-range RANGE -o OUT` with `extra` flags; it must succeed.
+fn bake_height(obj: &Path, height: &Path, range: &str, out: &Path, extra: &[&str]) -> std::process::Output {
+    let args = [&["bake", s(obj), "--height", s(height), "--height-range", range, "-o", s(out)][..], extra].concat();
+    run_ok(&args)
+}
+
 #[test]
 fn a_stretched_plane_is_bumped_in_world_units_along_both_axes() {
     let dir = scratch_dir("bake_surface_stretched");
@@ -80,18 +86,7 @@ fn a_stretched_plane_is_bumped_in_world_units_along_both_axes() {
     let obj = stretched_plane(&dir, sx, sy);
     let out = dir.join("plane.glb");
     let height = dir.join("height.png");
-    let o = run_ok(&[
-        "bake",
-        s(&obj),
-        "--height",
-        s(&height),
-        "--height-range",
-        "0.05",
-        "--bits16",
-        "-o",
-        s(&out),
-        "--json",
-    ]);
+    let o = bake_height(&obj, &height, "0.05", &out, &["--bits16", "--json"]);
     let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(rep["maps"][0]["source"], "height");
     assert!(rep["warnings"].as_array().unwrap().is_empty(), "{}", rep["warnings"]);
@@ -103,19 +98,7 @@ fn a_stretched_plane_is_bumped_in_world_units_along_both_axes() {
     // One texel size for the whole map (the U extent's) is right along U and 3x too steep along V.
     let uniform = dir.join("uniform.glb");
     let texel = format!("{}", sx / W as f64);
-    run_ok(&[
-        "bake",
-        s(&obj),
-        "--height",
-        s(&height),
-        "--height-range",
-        "0.05",
-        "--texel-size",
-        &texel,
-        "--bits16",
-        "-o",
-        s(&uniform),
-    ]);
+    bake_height(&obj, &height, "0.05", &uniform, &["--texel-size", &texel, "--bits16"]);
     let (mean_u, _) = errors(&baked_normals(&uniform), d, sx, sy);
     assert!(mean_u > 20.0 * mean, "one texel size: mean {mean_u:.4}° against {mean:.4}° through the mesh");
 }
@@ -127,12 +110,12 @@ fn invert_turns_the_relief_over_and_a_flat_result_is_named() {
     let obj = stretched_plane(&dir, sx, sy);
     let height = dir.join("height.png");
     let out = dir.join("inverted.glb");
-    run_ok(&["bake", s(&obj), "--height", s(&height), "--height-range", "0.01", "--invert", "--bits16", "-o", s(&out)]);
+    bake_height(&obj, &height, "0.01", &out, &["--invert", "--bits16"]);
     let (mean, _) = errors(&baked_normals(&out), -d, sx, sy);
     assert!(mean < 0.01, "inverted: mean {mean:.4}°");
 
     let tiny = dir.join("tiny.glb");
-    let o = run_ok(&["bake", s(&obj), "--height", s(&height), "--height-range", "1e-7", "-o", s(&tiny), "--json"]);
+    let o = bake_height(&obj, &height, "1e-7", &tiny, &["--json"]);
     let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let w = rep["warnings"][0].as_str().unwrap_or_default();
     assert!(w.contains("flat") && w.contains("--height-range"), "{w}");
