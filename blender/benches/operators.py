@@ -32,26 +32,9 @@ SAMPLES = tuple(int(s) for s in (sys.argv[4] if len(sys.argv) > 4 else "1,16").s
 
 
 def cycles_selected(mat, size: int, samples: int) -> float:
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    target = bpy.data.images.new("cycles", size, size, alpha=True, float_buffer=True)
-    node = mat.node_tree.nodes.new("ShaderNodeTexImage")
-    node.image = target
-    mat.node_tree.nodes.active = node
-    start = time.perf_counter()
-    bpy.ops.object.bake(
-        type="NORMAL",
-        normal_space="TANGENT",
-        use_selected_to_active=True,
-        cage_extrusion=0.1,
-        max_ray_distance=0.2,
-        margin=16,
-        target="IMAGE_TEXTURES",
+    _, seconds = conftest.cycles_bake(
+        mat, size, samples, use_selected_to_active=True, cage_extrusion=0.1, max_ray_distance=0.2, margin=16
     )
-    seconds = time.perf_counter() - start
-    mat.node_tree.nodes.remove(node)
     return seconds
 
 

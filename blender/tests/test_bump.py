@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 import pytest
-from conftest import clear_scene, findings, glb_json, keep_for_khronos, new_material
+from conftest import clear_scene, cycles_bake, findings, glb_json, keep_for_khronos, new_material
 
 bpy = pytest.importorskip("bpy")
 
@@ -56,28 +56,11 @@ def bump_scene(kind: str, distance: float = 0.02, strength: float = 1.0, invert:
 
 
 def cycles_normal_bake(obj, mat, samples: int = 4) -> tuple[np.ndarray, float]:
-    """Cycles' tangent-space NORMAL bake of the material as it is: (rows, cols, 4) from the top
-    (alpha 0 where no texel was baked), and the bake's seconds."""
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    target = bpy.data.images.new("cycles", SIZE, SIZE, alpha=True, float_buffer=True)
-    target.colorspace_settings.name = "Non-Color"
-    target.generated_color = (0, 0, 0, 0)
-    node = mat.node_tree.nodes.new("ShaderNodeTexImage")
-    node.image = target
-    mat.node_tree.nodes.active = node
+    """Cycles' bake of `obj` with its material as it is (`conftest.cycles_bake`)."""
     bpy.ops.object.select_all(action="DESELECT")
     obj.select_set(True)
     bpy.context.view_layer.objects.active = obj
-    start = time.perf_counter()
-    bpy.ops.object.bake(type="NORMAL", normal_space="TANGENT", margin=0, use_clear=False, target="IMAGE_TEXTURES")
-    seconds = time.perf_counter() - start
-    px = np.empty(SIZE * SIZE * 4, np.float32)
-    target.pixels.foreach_get(px)
-    mat.node_tree.nodes.remove(node)
-    return px.reshape(SIZE, SIZE, 4)[::-1], seconds
+    return cycles_bake(mat, SIZE, samples, margin=0, use_clear=False)
 
 
 def converted_map(mat) -> np.ndarray:

@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 import pytest
-from conftest import clear_scene, new_material
+from conftest import clear_scene, cycles_bake, new_material
 
 bpy = pytest.importorskip("bpy")
 
@@ -104,30 +104,9 @@ def test_selected_to_active_is_bake_from_on_the_same_meshes(tmp_path):
 
 def test_selected_to_active_is_close_to_cycles():
     _, _, mat = bumpy_pair()
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 4
-    target = bpy.data.images.new("cycles", SIZE, SIZE, alpha=True, float_buffer=True)
-    target.colorspace_settings.name = "Non-Color"
-    target.generated_color = (0, 0, 0, 0)
-    node = mat.node_tree.nodes.new("ShaderNodeTexImage")
-    node.image = target
-    mat.node_tree.nodes.active = node
-    start = time.perf_counter()
-    bpy.ops.object.bake(
-        type="NORMAL",
-        normal_space="TANGENT",
-        use_selected_to_active=True,
-        cage_extrusion=0.1,
-        max_ray_distance=0.2,
-        margin=0,
-        use_clear=False,
-        target="IMAGE_TEXTURES",
+    ref, cycles_s = cycles_bake(
+        mat, SIZE, 4, use_selected_to_active=True, cage_extrusion=0.1, max_ray_distance=0.2, margin=0, use_clear=False
     )
-    cycles_s = time.perf_counter() - start
-    ref = pixels(target)
-    mat.node_tree.nodes.remove(node)
     start = time.perf_counter()
     assert "FINISHED" in bpy.ops.bumpbake.bake_selected_to_active(
         size=SIZE, extrusion=0.1, max_ray_distance=0.2, samples=2, padding=0
