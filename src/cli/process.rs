@@ -17,7 +17,7 @@
 /// map's normals). By default glibc gives back the free top of a heap past 128 KB, and the next
 /// array faults every page in again. Keeping 64 MB free at the top of each heap lets the next
 /// stage reuse them: on the 600k-triangle bench, 34k page faults instead of 45k and 4-5% less
-/// time, for 12 MB more peak (docs/transfer.md). Other commands keep the default pad: their
+/// time, for 12 MB more peak (docs/transfer-history.md). Other commands keep the default pad: their
 /// figures are peak memory against the mesh.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 pub fn tune_the_allocator(bakes_from_high: bool) {

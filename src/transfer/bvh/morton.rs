@@ -69,7 +69,7 @@ fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
     // core too: each chunk of the keys writes its share of every bucket into a slice of its own,
     // after the earlier chunks' shares, so the order is the same on any thread count. 256
     // buckets, not more: the pass writes to as many places at once, and with 4096 it slowed
-    // faster than the keys grew (docs/transfer.md, "The tree build, third step").
+    // faster than the keys grew (docs/transfer.md, "The tree build").
     let top = |k: u64| (k >> (INDEX_BITS + LOW_BITS)) as usize;
     let chunk = n.div_ceil(CHUNKS).max(1);
     let counts: Vec<[usize; BUCKETS]> = keys
