@@ -10,12 +10,13 @@
 //! whatever the piece size or thread count. The pieces' arrays are reused from block to block and
 //! copied into the growing output on every core, each at its place.
 
+use super::continuation::{join, next_line_end};
 use super::piece::{count, Counts, Forward, Piece};
 use crate::error::{Error, Result};
 use crate::format::mesh::{StoredMesh, MISSING};
 use crate::progress::Reporter;
-use memchr::memchr;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::mem::MaybeUninit;
 use std::path::Path;
 
@@ -49,10 +50,19 @@ impl Acc {
     }
 
     fn parse_and_place<const FAST: bool>(&mut self, path: &Path, texts: &[&[u8]], pieces: &mut [Piece]) -> Result<()> {
-        pieces.par_iter_mut().zip(texts).for_each(|(p, t)| {
+        // A piece holding a continued line is read joined; each piece is looked through for one
+        // on the core that parses it, just before, while its text is in that core's cache.
+        let mut joined: Vec<Option<Vec<u8>>> = vec![None; texts.len()];
+        pieces.par_iter_mut().zip(texts).zip(&mut joined).for_each(|((p, t), j)| {
+            if let Cow::Owned(v) = join(t) {
+                *j = Some(v);
+            }
+            let t = j.as_deref().unwrap_or(t);
             p.parse::<FAST>(t, None);
             self.progress.tick(t.len() as u64);
         });
+        let texts: Vec<&[u8]> = texts.iter().zip(&joined).map(|(&t, j)| j.as_deref().unwrap_or(t)).collect();
+        let texts = &texts[..];
         pieces.par_iter_mut().zip(texts).filter(|(p, _)| p.needs_base).for_each(|(p, t)| p.counts = count(t));
 
         // Bases up to the first piece that failed: an error there is the block's first unless a
@@ -194,14 +204,14 @@ fn append<T: Copy + Send + Sync>(
     unsafe { out.set_len(out.len() + total) };
 }
 
-/// Cuts `bytes` after a newline near every `piece` bytes.
+/// Cuts `bytes` after a line end near every `piece` bytes (never inside a continued line).
 fn split(bytes: &[u8], piece: usize) -> Vec<&[u8]> {
     let mut out = Vec::with_capacity(bytes.len() / piece + 1);
     let mut rest = bytes;
     while rest.len() > piece {
-        match memchr(b'\n', &rest[piece - 1..]) {
-            Some(k) => {
-                let (a, b) = rest.split_at(piece + k);
+        match next_line_end(rest, piece - 1) {
+            Some(end) => {
+                let (a, b) = rest.split_at(end);
                 out.push(a);
                 rest = b;
             }

@@ -1,5 +1,5 @@
 //! Reading Wavefront OBJ (+ MTL) into the glTF model: the geometry through the parallel parser
-//! (`parse.rs`, `block.rs`, `piece.rs`, `fast.rs`), the MTL libraries through `tobj` (`mtl.rs`).
+//! (`parse.rs`, `block.rs`, `piece.rs`, `fast.rs`, `continuation.rs`), the MTL libraries through `tobj` (`mtl.rs`).
 //! Each run of one name and material becomes a primitive, its corners renumbered in first-use
 //! order as tobj numbers a model's, so the welded output matches tobj's reading of the file.
 //!
@@ -8,6 +8,7 @@
 //! the glTF `w` rule, the reference sign negated, flips it back: the frames are the same).
 
 mod block;
+mod continuation;
 mod fast;
 mod mtl;
 pub mod parse;

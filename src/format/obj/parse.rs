@@ -10,10 +10,10 @@
 //! and `raw.rs` (HIGH's mesh) convert. Polygons are fanned from their first corner, as `tobj` did.
 
 use super::block::Acc;
+use super::continuation::last_line_end;
 use crate::error::{Error, Result};
 use crate::format::mesh::StoredMesh;
 use crate::progress::{Counting, Reporter};
-use memchr::memrchr;
 use std::io::Read;
 use std::ops::Deref;
 use std::path::Path;
@@ -77,7 +77,8 @@ fn reported(
 }
 
 /// Parses `len` bytes seen through `window(at, n)` (bytes `at..at + n`), a block at a time: each
-/// window runs to the last line end in it (it grows when one line is longer than a block).
+/// window runs to the last line end in it that is not continued (it grows when one line is
+/// longer than a block).
 fn windows<const FAST: bool, W: Deref<Target = [u8]>>(
     path: &Path,
     len: u64,
@@ -93,7 +94,7 @@ fn windows<const FAST: bool, W: Deref<Target = [u8]>>(
         let n = usize::try_from(len - at).unwrap_or(usize::MAX).min(want);
         let w = window(at, n)?;
         let last = at + n as u64 == len;
-        let Some(cut) = (if last { Some(n) } else { memrchr(b'\n', &w).map(|i| i + 1) }) else {
+        let Some(cut) = (if last { Some(n) } else { last_line_end(&w) }) else {
             want *= 2;
             continue;
         };
@@ -139,7 +140,7 @@ pub fn parse_reader(path: &Path, mut r: impl Read, piece: usize) -> Result<Store
         let data = &buf[..filled];
         let start = if first && data.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
         first = false;
-        let cut = if eof { filled } else { memrchr(b'\n', data).map_or(start, |i| i + 1) };
+        let cut = if eof { filled } else { last_line_end(data).unwrap_or(start) };
         acc.block::<true>(path, &data[start..cut], piece)?;
         buf.copy_within(cut..filled, 0);
         kept = filled - cut;

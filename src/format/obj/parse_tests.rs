@@ -190,6 +190,32 @@ fn any_piece_size_gives_the_same_result() {
     }
 }
 
+/// Lines continued by `\` (any line, comments too, as Blender reads them) read as the joined
+/// text, for every piece size and through a reader, and an error after them names its line.
+#[test]
+fn continued_lines_read_as_joined() {
+    let (mut cont, mut plain) = (String::new(), String::new());
+    for i in 0..30 {
+        cont += &format!("v {i} \\\n 0 \\ \r\n 0\nvt {i} 1\n");
+        plain += &format!("v {i} 0 0\n\n\nvt {i} 1\n");
+        if i >= 2 {
+            cont += "f -1/-1 \\\n-2/-2 \\\t\n -3/-3\n# a comment \\\nv 9 9 9\n";
+            plain += "f -1/-1 -2/-2 -3/-3\n\n\n# a comment\n\n";
+        }
+    }
+    let whole = parse(&plain);
+    assert_eq!((whole.positions.len(), whole.triangles.len()), (30, 28));
+    for piece in [1, 2, 3, 5, 7, 16, 64, 1000] {
+        assert_eq!(pieces(&cont, piece).unwrap(), whole, "piece {piece}");
+    }
+    let line = cont.lines().count() + 1;
+    let bad = format!("{cont}f 1 2 \\\n 999\nv 0 0 0\n");
+    for piece in [1, 3, 64, 1 << 20] {
+        let e = pieces(&bad, piece).unwrap_err();
+        assert!(e.contains(&format!("line {line}:")), "{e}");
+    }
+}
+
 /// `s` parsed with pieces of about `piece` bytes, both from memory and through a reader.
 fn pieces(s: &str, piece: usize) -> std::result::Result<StoredMesh, String> {
     let path = Path::new("t.obj");
