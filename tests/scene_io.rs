@@ -151,6 +151,47 @@ fn obj_without_normals_with_quads_and_normal_map() {
     }
 }
 
+/// Smoothing groups in a file without `vn`: the two quads at right angles share vertex 2's
+/// normal only when they are in one group; in two groups, or with `s off`, each keeps its own
+/// face normal there, and the tangents follow.
+#[test]
+fn obj_smoothing_groups_make_hard_edges() {
+    let d = scratch_dir("obj_groups_in");
+    let v = validated_dir("obj_groups");
+    let body = |first: &str, second: &str| {
+        format!(
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 0 -1\nv 1 1 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n{first}\nf 1/1 2/2 3/3 4/4\n{second}\nf 2/1 5/2 6/3 3/4\n"
+        )
+    };
+    let s2 = std::f32::consts::FRAC_1_SQRT_2;
+    for (name, first, second, shared) in
+        [("one", "s 1", "s 1", true), ("two", "s 1", "s 2", false), ("off", "s off", "", false)]
+    {
+        std::fs::write(d.join(format!("{name}.obj")), body(first, second)).unwrap();
+        let out = v.join(format!("{name}.glb"));
+        run_ok(&["tangents", s(&d.join(format!("{name}.obj"))), "-o", s(&out), "--all", "-q"]);
+        let scene = load(&out);
+        let n = corner_attr::<3>(&scene, P0, "NORMAL");
+        let t = corner_attr::<4>(&scene, P0, "TANGENT");
+        for c in 0..12 {
+            assert_valid_frame(t[c], n[c], &format!("{name} corner {c}"));
+        }
+        // Corner 1 is vertex 2 in the top quad; corner 6 is vertex 2 in the side quad.
+        if shared {
+            for c in [1, 6] {
+                assert!((glam::Vec3::from(n[c]) - glam::Vec3::new(s2, 0.0, s2)).length() < 1e-6, "{name}: {:?}", n[c]);
+            }
+        } else {
+            assert_eq!((n[1], n[6]), ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]), "{name}");
+        }
+        // `--normals flat` is flat whatever the groups say.
+        let flat = v.join(format!("{name}_flat.glb"));
+        run_ok(&["tangents", s(&d.join(format!("{name}.obj"))), "-o", s(&flat), "--all", "--normals", "flat", "-q"]);
+        let n = corner_attr::<3>(&load(&flat), P0, "NORMAL");
+        assert_eq!((n[1], n[6]), ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]), "{name} flat");
+    }
+}
+
 #[test]
 fn obj_height_bump_is_reported_for_bake() {
     let d = scratch_dir("obj_height_in");

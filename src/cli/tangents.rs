@@ -28,7 +28,8 @@ pub struct Args {
     /// Also write the bitangent cross(N, T) * w as a _BITANGENT attribute.
     #[arg(long)]
     pub bitangents: bool,
-    /// Normals for OBJ meshes without `vn`.
+    /// Normals for OBJ meshes without `vn`: smooth within the file's smoothing groups (`s`;
+    /// faces in none are flat), or flat everywhere.
     #[arg(long, value_enum, default_value = "smooth")]
     pub normals: Normals,
     #[command(flatten)]

@@ -57,16 +57,67 @@ fn accumulate(
 ) -> Vec<glam::Vec3> {
     let mut acc = vec![glam::Vec3::ZERO; vertices];
     for t in triangles {
-        let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-        let Some(n) = face_normal(a, b, c) else { continue };
-        for (k, (o, u, v)) in [(a, b, c), (b, c, a), (c, a, b)].into_iter().enumerate() {
-            let e1 = pow2_scaled(u - o).normalize_or_zero();
-            let e2 = pow2_scaled(v - o).normalize_or_zero();
-            let angle = e1.dot(e2).clamp(-1.0, 1.0).acos();
-            acc[t[k] as usize] += n * angle;
+        for (k, w) in corner_weights(t.map(&p)).into_iter().flatten().enumerate() {
+            acc[t[k] as usize] += w;
         }
     }
     acc
+}
+
+/// What triangle `(a, b, c)` adds to each corner's normal: its face normal weighted by the
+/// corner's angle; `None` for a triangle without area.
+fn corner_weights([a, b, c]: [glam::Vec3; 3]) -> Option<[glam::Vec3; 3]> {
+    let n = face_normal(a, b, c)?;
+    Some([(a, b, c), (b, c, a), (c, a, b)].map(|(o, u, v)| {
+        let e1 = pow2_scaled(u - o).normalize_or_zero();
+        let e2 = pow2_scaled(v - o).normalize_or_zero();
+        n * e1.dot(e2).clamp(-1.0, 1.0).acos()
+    }))
+}
+
+/// Normals shared only within a smoothing group (OBJ's `s`): `groups` gives each triangle's, 0
+/// for none. A vertex's normal in a group is the angle-weighted sum over that group's faces
+/// around it; a face in no group is flat. Returns the normals and each triangle's three indices
+/// into them, and how many normals had no direction (only faces without area): they point
+/// along +Z.
+pub fn grouped_normals(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    groups: &[u64],
+) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, usize) {
+    let mut slots: std::collections::HashMap<(u32, u64), u32> = std::collections::HashMap::new();
+    let mut acc: Vec<glam::Vec3> = Vec::new();
+    let mut index = Vec::with_capacity(triangles.len());
+    for (t, &g) in triangles.iter().zip(groups) {
+        let p = t.map(|i| glam::Vec3::from(positions[i as usize]));
+        let w = corner_weights(p);
+        let ids = if g == 0 {
+            acc.push(face_normal(p[0], p[1], p[2]).unwrap_or(glam::Vec3::ZERO));
+            [acc.len() as u32 - 1; 3]
+        } else {
+            t.map(|i| {
+                *slots.entry((i, g)).or_insert_with(|| {
+                    acc.push(glam::Vec3::ZERO);
+                    acc.len() as u32 - 1
+                })
+            })
+        };
+        if let (Some(w), true) = (w, g != 0) {
+            (0..3).for_each(|k| acc[ids[k] as usize] += w[k]);
+        }
+        index.push(ids);
+    }
+    let mut fixed = 0;
+    let normals = acc
+        .into_iter()
+        .map(|n| {
+            unit_or_z(n).unwrap_or_else(|| {
+                fixed += 1;
+                [0.0, 0.0, 1.0]
+            })
+        })
+        .collect();
+    (normals, index, fixed)
 }
 
 fn unit_or_z(sum: glam::Vec3) -> Option<[f32; 3]> {

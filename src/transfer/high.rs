@@ -64,10 +64,11 @@ pub fn read_high(path: &Path, opts: &ReadOptions) -> Result<HighMesh> {
 }
 
 /// An OBJ file's arrays as a mesh: parts at `o`/`g` and at `usemtl` changes.
-pub fn from_obj(path: &Path, d: StoredMesh) -> Result<HighMesh> {
+pub fn from_obj(path: &Path, mut d: StoredMesh) -> Result<HighMesh> {
     // The PLY parser checks its positions as it reads them; the OBJ parser leaves it to the glue,
     // which names the object on the Scene path.
     check_finite(path, &d.positions)?;
+    crate::format::obj::normals_from_groups(&mut d);
     from_stored(path, d, "unnamed_object")
 }
 

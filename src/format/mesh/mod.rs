@@ -21,6 +21,8 @@ pub enum Statement {
     Name(String),
     /// `usemtl` with its material name.
     Material(String),
+    /// `s` with its smoothing group: 0 for `off` (each face flat).
+    Smooth(u64),
 }
 
 /// A mesh as stored, triangulated (polygons fanned from their first corner).
@@ -82,6 +84,7 @@ pub fn runs<M: Clone + PartialEq>(
                     current = m;
                 }
             }
+            Statement::Smooth(_) => {}
         }
     }
     close(&name, &current, start..triangles, &mut out);

@@ -13,13 +13,15 @@ mod fast;
 mod mtl;
 pub mod parse;
 mod piece;
+mod smoothing;
 
 use super::mesh::to_gltf::{build_primitive, empty_scene, set_nodes, Model};
 use super::mesh::{runs, StoredMesh, MISSING};
 use crate::error::{Error, Result};
-use crate::scene::{array_mut, set_key, PrimRef, ReadOptions, Scene, SourceFormat};
+use crate::scene::{array_mut, set_key, NormalMode, PrimRef, ReadOptions, Scene, SourceFormat};
 use mtl::{add_material, load_materials};
 use serde_json::json;
+pub use smoothing::normals_from_groups;
 use std::path::Path;
 
 /// Reads the OBJ file at `path`, streaming it through the parallel parser.
@@ -35,11 +37,21 @@ pub fn read(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Scene> {
     build_scene(path, data, opts)
 }
 
-fn build_scene(path: &Path, data: StoredMesh, opts: &ReadOptions) -> Result<Scene> {
+fn build_scene(path: &Path, mut data: StoredMesh, opts: &ReadOptions) -> Result<Scene> {
+    // Flat normals are asked for everywhere; smooth ones within the file's smoothing groups.
+    let directionless = match opts.obj_normals {
+        NormalMode::Smooth => normals_from_groups(&mut data),
+        NormalMode::Flat => 0,
+    };
     let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let (materials, material_ids, mtl_files) = load_materials(path, &base_dir, &data.mtllibs, opts)?;
 
     let mut scene = empty_scene(path, opts, SourceFormat::Obj, mtl_files);
+    if directionless > 0 {
+        scene.notes.push(format!(
+            "{directionless} normals of the smoothing groups had no direction (only faces without area around them); they point along +Z"
+        ));
+    }
     for (i, m) in materials.iter().enumerate() {
         add_material(&mut scene, i, m)?;
     }

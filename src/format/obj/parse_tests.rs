@@ -27,7 +27,8 @@ fn every_listed_syntax() {
         "v 0 0 1\n",
         "g\n",
         "f -4/-2/-1 -3/-1 -2 -1\n",   // relative, a quad
-        "s off\nl 1 2\np 1\nf 1 2\n", // no surface
+        "s off\nl 1 2\np 1\nf 1 2\n", // a smoothing group; no surface
+        "s 12 # a group number\n",
         "usemtl  \tblue\n",
     ));
     assert_eq!(d.positions, vec![[1e-3, -0.0, 25.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
@@ -43,6 +44,8 @@ fn every_listed_syntax() {
             (0, Statement::Name("first part".into())),
             (0, Statement::Material("red".into())),
             (1, Statement::Name("unnamed_object".into())),
+            (3, Statement::Smooth(0)),
+            (3, Statement::Smooth(12)),
             (3, Statement::Material("blue".into())),
         ]
     );

@@ -31,6 +31,7 @@ enum Kind {
     Name,
     Usemtl,
     Mtllib,
+    Smooth,
     Other,
 }
 
@@ -51,6 +52,7 @@ fn keyword(b: &[u8], mut i: usize) -> (Kind, usize) {
         b"o" | b"g" => Kind::Name,
         b"usemtl" => Kind::Usemtl,
         b"mtllib" => Kind::Mtllib,
+        b"s" => Kind::Smooth,
         _ => Kind::Other,
     };
     (k, i)
@@ -218,6 +220,13 @@ impl Piece {
                 }
                 Kind::Mtllib => {
                     self.mtllibs.push(l.rest());
+                    Ok(())
+                }
+                Kind::Smooth => {
+                    // `off`, and anything that is not a group number, is no group, as Blender
+                    // reads it.
+                    let group = l.token().and_then(|t| std::str::from_utf8(t).ok()?.parse().ok()).unwrap_or(0);
+                    self.statements.push((self.tv.len() as u32, Statement::Smooth(group)));
                     Ok(())
                 }
                 Kind::Other => Ok(()),
