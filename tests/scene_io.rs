@@ -192,6 +192,41 @@ fn obj_smoothing_groups_make_hard_edges() {
     }
 }
 
+/// Files Blender 5.0.1 wrote without normals, with its smoothing groups (plain and bit-flag),
+/// read with the normals Blender itself exports for the same mesh (`fixtures/blender_obj/`: a
+/// cylinder with hard cap edges and two hard side edges, and a flat cube), corner for corner,
+/// as a Scene and as HIGH for `bake --from`.
+#[test]
+fn obj_smoothing_groups_give_blenders_own_normals() {
+    let want = load(&fixture("blender_obj/normals.obj"));
+    let want_high =
+        bumpbake::transfer::high::read_high(&fixture("blender_obj/normals.obj"), &Default::default()).unwrap();
+    // Blender writes `vn` with four decimals.
+    let close = |a: [f32; 3], b: [f32; 3]| (glam::Vec3::from(a) - glam::Vec3::from(b)).length() < 1e-4;
+    for name in ["groups", "bitflags"] {
+        let path = fixture(&format!("blender_obj/{name}.obj"));
+        let got = load(&path);
+        for mesh in 0..2 {
+            let r = bumpbake::scene::PrimRef { mesh, primitive: 0 };
+            let (g, w) = (corner_attr::<3>(&got, r, "NORMAL"), corner_attr::<3>(&want, r, "NORMAL"));
+            assert_eq!(g.len(), w.len());
+            let off = g.iter().zip(&w).filter(|(a, b)| !close(**a, **b)).count();
+            assert_eq!(off, 0, "{name}, mesh {mesh}: {off} of {} corners differ from Blender's", g.len());
+        }
+        let high = bumpbake::transfer::high::read_high(&path, &Default::default()).unwrap();
+        let corner =
+            |h: &bumpbake::transfer::high::HighMesh, t: usize, k: usize| h.normals[h.normal_triangles[t][k] as usize];
+        for t in 0..high.triangles.len() {
+            for k in 0..3 {
+                assert!(
+                    close(corner(&high, t, k), corner(&want_high, t, k)),
+                    "{name} as HIGH: triangle {t} corner {k}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn obj_height_bump_is_reported_for_bake() {
     let d = scratch_dir("obj_height_in");
