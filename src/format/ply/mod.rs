@@ -114,6 +114,9 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<StoredMesh> {
     let mut cur = Cursor { b: &bytes[body..], i: 0, enc };
     let mut mesh = StoredMesh::default();
     let mut have_vertices = false;
+    // Elements may come in any order: faces before their vertices are checked against the
+    // vertex count the header declares, which the vertex element must then hold.
+    let declared = elements.iter().find(|e| e.name == "vertex").map(|e| e.count);
     for el in &elements {
         // Each record takes at least this many bytes, so a count the file cannot hold is caught
         // before anything is allocated.
@@ -226,15 +229,13 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<StoredMesh> {
                     .iter()
                     .position(|p| p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index"))
                     .ok_or_else(|| err("the 'face' element has no vertex_indices list".to_string()))?;
-                if !have_vertices {
-                    return Err(err("'face' comes before 'vertex': faces must follow their vertices".to_string()));
-                }
+                let Some(declared) = declared else { return Err(err("has no 'vertex' element".to_string())) };
                 if matches!(el.props[list].ty, Ty::F32 | Ty::F64) {
                     return Err(err(
                         "the 'face' element's vertex indices are floats: they must be integers".to_string()
                     ));
                 }
-                let nv = mesh.positions.len() as u64;
+                let nv = if have_vertices { mesh.positions.len() as u64 } else { declared };
                 if enc == Encoding::Ascii {
                     if let Some((tris, used)) = ascii::faces(el, list, &cur.b[cur.i..], nv) {
                         mesh.triangles = tris;

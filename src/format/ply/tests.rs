@@ -3,6 +3,11 @@ use super::*;
 /// A quad (two triangles after fanning) and a lone triangle, with normals, UVs and an extra
 /// property and element to skip, in the given encoding.
 fn sample(enc: &str) -> Vec<u8> {
+    sample_in_order(enc, false)
+}
+
+/// [`sample`], with its face element before its vertex element when `faces_first`.
+fn sample_in_order(enc: &str, faces_first: bool) -> Vec<u8> {
     let verts: [[f32; 8]; 5] = [
         [0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0],
         [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0],
@@ -11,13 +16,15 @@ fn sample(enc: &str) -> Vec<u8> {
         [0.1, -0.5, 3.25, 0.0, 1.0, 0.0, 0.5, 0.25],
     ];
     let faces: [&[i32]; 2] = [&[0, 1, 2, 3], &[4, 1, 0]];
+    let vertex = "element vertex 5\nproperty float x\nproperty float y\nproperty double z\nproperty float nx\n\
+                  property float ny\nproperty float nz\nproperty uchar flags\nproperty float s\nproperty float t\n";
+    let face = "element face 2\nproperty uint8 flags\nproperty list uchar int vertex_indices\n";
+    let (first, second) = if faces_first { (face, vertex) } else { (vertex, face) };
     let mut out = format!(
-        "ply\nformat {enc} 1.0\ncomment made by a test\nelement vertex 5\nproperty float x\nproperty float y\n\
-         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty uchar flags\n\
-         property float s\nproperty float t\nelement face 2\nproperty uint8 flags\nproperty list uchar int vertex_indices\n\
-         element edge 1\nproperty int a\nproperty int b\nend_header\n"
+        "ply\nformat {enc} 1.0\ncomment made by a test\n{first}{second}element edge 1\nproperty int a\nproperty int b\nend_header\n"
     )
     .into_bytes();
+    let mut face_bytes = Vec::new();
     let be = enc == "binary_big_endian";
     let put = |out: &mut Vec<u8>, b: &[u8]| {
         let mut b = b.to_vec();
@@ -43,6 +50,7 @@ fn sample(enc: &str) -> Vec<u8> {
         }
     }
     for f in faces {
+        let out = &mut face_bytes;
         if enc == "ascii" {
             let idx: Vec<String> = f.iter().map(|i| i.to_string()).collect();
             out.extend(format!("0 {} {}\n", f.len(), idx.join(" ")).bytes());
@@ -51,8 +59,14 @@ fn sample(enc: &str) -> Vec<u8> {
         out.push(0);
         out.push(f.len() as u8);
         for i in f {
-            put(&mut out, &i.to_le_bytes());
+            put(out, &i.to_le_bytes());
         }
+    }
+    if faces_first {
+        let header_end = out.windows(11).position(|w| w == b"end_header\n").expect("a header") + 11;
+        out.splice(header_end..header_end, face_bytes);
+    } else {
+        out.extend(face_bytes);
     }
     if enc == "ascii" {
         out.extend(b"0 1\n");
@@ -76,6 +90,13 @@ fn ascii_and_both_binaries_read_the_same_mesh() {
     assert_eq!(m.uvs[2], [1.0, 1.0]);
     assert_eq!(read(&sample("binary_little_endian")).unwrap(), m);
     assert_eq!(read(&sample("binary_big_endian")).unwrap(), m);
+    // Elements may come in any order: faces before their vertices read the same.
+    for enc in ["ascii", "binary_little_endian", "binary_big_endian"] {
+        assert_eq!(read(&sample_in_order(enc, true)).unwrap(), m, "{enc}, faces first");
+    }
+    // Checked against the vertex count the header declares.
+    let bad = String::from_utf8_lossy(&sample_in_order("ascii", true)).replace("0 3 4 1 0\n", "0 3 5 1 0\n");
+    assert!(read(bad.as_bytes()).unwrap_err().contains("face 2 names vertex 5, but there are 5 vertices"));
 }
 
 #[test]
