@@ -30,10 +30,11 @@ fn every_listed_syntax() {
         "s off\nl 1 2\np 1\nf 1 2\n", // a smoothing group; no surface
         "s 12 # a group number\n",
         "usemtl  \tblue\n",
+        "vt 0.75 # v left out: 0\n",
     ));
     assert_eq!(d.positions, vec![[1e-3, -0.0, 25.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
     assert!(d.positions[0][1].is_sign_negative());
-    assert_eq!(d.uvs, vec![[0.5, -0.0], [1.0, 1.0]]);
+    assert_eq!(d.uvs, vec![[0.5, -0.0], [1.0, 1.0], [0.75, 0.0]]);
     assert_eq!(d.normals, vec![[0.0, 0.0, 1.0]]);
     assert_eq!(d.triangles, vec![[0, 1, 2], [0, 1, 2], [0, 2, 3]]);
     assert_eq!(d.uv_triangles, vec![[0, MISSING, 0], [0, 1, MISSING], [0, MISSING, MISSING]]);
@@ -84,7 +85,8 @@ fn errors_name_the_line_and_the_way_out() {
     assert!(error("v 0 0 0\nf 1/1/1/1 1 1\n").contains("more than v/vt/vn"));
     assert!(error("v 0 0 0\nf 1/a 1 1\n").contains("not v, v/vt"));
     assert!(error("usemtl\n").contains("line 1: usemtl names no material"));
-    assert!(error("vt 1\n").contains("vt has too few numbers"));
+    assert!(error("vt\n").contains("vt has too few numbers"));
+    assert!(error("vt 1 x\n").contains("line 1: vt: 'x' is not a number"));
 }
 
 #[test]

@@ -153,6 +153,16 @@ impl<'a> Line<'a> {
         parse_f32(t).ok_or_else(|| format!("{what}: '{}' is not a number", String::from_utf8_lossy(t)))
     }
 
+    /// The next number if the line has one more token, `None` at its end.
+    fn optional_float(&mut self, what: &str) -> std::result::Result<Option<f32>, String> {
+        match self.token() {
+            None => Ok(None),
+            Some(t) => parse_f32(t)
+                .map(Some)
+                .ok_or_else(|| format!("{what}: '{}' is not a number", String::from_utf8_lossy(t))),
+        }
+    }
+
     /// The rest of the line, trimmed, as text.
     fn rest(&self) -> String {
         String::from_utf8_lossy(self.b[self.i..].trim_ascii()).into_owned()
@@ -192,7 +202,10 @@ impl Piece {
             let r: std::result::Result<(), Stop> = match kind {
                 Kind::V => self.vertex(&mut l).map_err(Stop::from),
                 Kind::Vt => (|| {
-                    self.uv.push([l.float("vt")?, l.float("vt")?]);
+                    // `vt u` alone: the specification's optional v is 0.
+                    let u = l.float("vt")?;
+                    let v = l.optional_float("vt")?.unwrap_or(0.0);
+                    self.uv.push([u, v]);
                     Ok(())
                 })(),
                 Kind::Vn => (|| {
