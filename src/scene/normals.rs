@@ -75,6 +75,21 @@ fn corner_weights([a, b, c]: [glam::Vec3; 3]) -> Option<[glam::Vec3; 3]> {
     }))
 }
 
+/// A new normal (`n`, of group `g`, followed by `after` among its position's): its index.
+fn push(
+    acc: &mut Vec<glam::Vec3>,
+    group: &mut Vec<u64>,
+    next: &mut Vec<u32>,
+    n: glam::Vec3,
+    g: u64,
+    after: u32,
+) -> u32 {
+    acc.push(n);
+    group.push(g);
+    next.push(after);
+    acc.len() as u32 - 1
+}
+
 /// Normals shared only within a smoothing group (OBJ's `s`): `groups` gives each triangle's, 0
 /// for none. A vertex's normal in a group is the angle-weighted sum over that group's faces
 /// around it; a face in no group is flat. Returns the normals and each triangle's three indices
@@ -85,24 +100,30 @@ pub fn grouped_normals(
     triangles: &[[u32; 3]],
     groups: &[u64],
 ) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, usize) {
-    let mut slots: std::collections::HashMap<(u32, u64), u32> = std::collections::HashMap::new();
+    // Per position, its first normal; per normal, its group and the position's next normal (a
+    // position has as many as the groups around it, rarely more than a few).
+    let mut head = vec![u32::MAX; positions.len()];
+    let (mut group, mut next): (Vec<u64>, Vec<u32>) = (Vec::new(), Vec::new());
     let mut acc: Vec<glam::Vec3> = Vec::new();
     let mut index = Vec::with_capacity(triangles.len());
     for (t, &g) in triangles.iter().zip(groups) {
         let p = t.map(|i| glam::Vec3::from(positions[i as usize]));
-        let w = corner_weights(p);
         let ids = if g == 0 {
-            acc.push(face_normal(p[0], p[1], p[2]).unwrap_or(glam::Vec3::ZERO));
-            [acc.len() as u32 - 1; 3]
+            [push(&mut acc, &mut group, &mut next, face_normal(p[0], p[1], p[2]).unwrap_or_default(), 0, u32::MAX); 3]
         } else {
             t.map(|i| {
-                *slots.entry((i, g)).or_insert_with(|| {
-                    acc.push(glam::Vec3::ZERO);
-                    acc.len() as u32 - 1
-                })
+                let mut k = head[i as usize];
+                while k != u32::MAX && group[k as usize] != g {
+                    k = next[k as usize];
+                }
+                if k == u32::MAX {
+                    k = push(&mut acc, &mut group, &mut next, glam::Vec3::ZERO, g, head[i as usize]);
+                    head[i as usize] = k;
+                }
+                k
             })
         };
-        if let (Some(w), true) = (w, g != 0) {
+        if let (Some(w), true) = (corner_weights(p), g != 0) {
             (0..3).for_each(|k| acc[ids[k] as usize] += w[k]);
         }
         index.push(ids);
