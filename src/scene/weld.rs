@@ -46,17 +46,31 @@ pub fn weld(attributes: Vec<(String, Stream)>, targets: Vec<Vec<(String, Stream)
             keys.extend_from_slice(s.elem(c));
         }
     }
-    let mut first: HashMap<&[u8], u32, BuildHasherDefault<Fx>> =
-        HashMap::with_capacity_and_hasher(corners, Default::default());
+    let key = |c: usize| &keys[c * stride..(c + 1) * stride];
+    // Equal corners found on every core (`first_equal`), each corner's hash computed there too.
+    let hashes: Vec<u64> = {
+        use rayon::prelude::*;
+        (0..corners)
+            .into_par_iter()
+            .map(|c| {
+                let mut h = Fx::default();
+                h.write(key(c));
+                h.0 | 1
+            })
+            .collect()
+    };
+    let first = first_equal(&hashes, |a, b| key(a) == key(b));
+    // Vertices numbered in the order their first corner appears (a corner's first comes no
+    // later than itself, so it is numbered already).
+    let mut number = vec![0u32; corners];
     let mut order: Vec<u32> = Vec::new();
     let mut indices = Vec::with_capacity(corners);
-    for c in 0..corners {
-        let next = order.len() as u32;
-        let v = *first.entry(&keys[c * stride..(c + 1) * stride]).or_insert_with(|| {
+    for (c, &f) in first.iter().enumerate() {
+        if f as usize == c {
+            number[c] = order.len() as u32;
             order.push(c as u32);
-            next
-        });
-        indices.push(v);
+        }
+        indices.push(number[f as usize]);
     }
     let gather = |list: Vec<(String, Stream)>| list.into_iter().map(|(n, s)| (n, s.gather(&order))).collect::<Vec<_>>();
     Primitive { attributes: gather(attributes), targets: targets.into_iter().map(gather).collect(), indices, mode }
@@ -347,6 +361,32 @@ mod tests {
         assert_eq!(p.attr("TEXCOORD_0").unwrap().to_f32::<2>()[2], [0.5, 0.0]);
         let (attrs, _) = unweld(&p);
         assert_eq!(attrs[1].1.to_f32::<2>(), vec![[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.5, 0.0]]);
+    }
+
+    /// Many corners over few values: vertices numbered in the order their first corner appears,
+    /// as a plain map over the corners in order numbers them.
+    #[test]
+    fn vertices_come_in_first_use_order() {
+        let mut x = 0x2545_f491u32;
+        let pos: Vec<[f32; 3]> = (0..5000)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                [(x % 300) as f32, 1.0, 0.0]
+            })
+            .collect();
+        let p = weld(vec![("POSITION".into(), Stream::from_f32("VEC3", &pos))], vec![], 4);
+        let mut seen = std::collections::HashMap::new();
+        let want: Vec<u32> = pos
+            .iter()
+            .map(|v| {
+                let n = seen.len() as u32;
+                *seen.entry(v[0].to_bits()).or_insert(n)
+            })
+            .collect();
+        assert_eq!(p.indices, want);
+        assert_eq!(p.vertex_count(), seen.len());
     }
 
     #[test]
