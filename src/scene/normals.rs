@@ -75,19 +75,11 @@ fn corner_weights([a, b, c]: [glam::Vec3; 3]) -> Option<[glam::Vec3; 3]> {
     }))
 }
 
-/// A new normal (`n`, of group `g`, followed by `after` among its position's): its index.
-fn push(
-    acc: &mut Vec<glam::Vec3>,
-    group: &mut Vec<u64>,
-    next: &mut Vec<u32>,
-    n: glam::Vec3,
-    g: u64,
-    after: u32,
-) -> u32 {
-    acc.push(n);
-    group.push(g);
-    next.push(after);
-    acc.len() as u32 - 1
+/// A normal being summed: its group, and the next normal of the same position.
+struct Slot {
+    sum: glam::Vec3,
+    group: u64,
+    next: u32,
 }
 
 /// Normals shared only within a smoothing group (OBJ's `s`): `groups` gives each triangle's, 0
@@ -100,39 +92,41 @@ pub fn grouped_normals(
     triangles: &[[u32; 3]],
     groups: &[u64],
 ) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, usize) {
-    // Per position, its first normal; per normal, its group and the position's next normal (a
-    // position has as many as the groups around it, rarely more than a few).
+    // Per position, its first normal; each normal links to the position's next (a position has
+    // as many as the groups around it, rarely more than a few).
     let mut head = vec![u32::MAX; positions.len()];
-    let (mut group, mut next): (Vec<u64>, Vec<u32>) = (Vec::new(), Vec::new());
-    let mut acc: Vec<glam::Vec3> = Vec::new();
+    let mut slots: Vec<Slot> = Vec::new();
     let mut index = Vec::with_capacity(triangles.len());
     for (t, &g) in triangles.iter().zip(groups) {
         let p = t.map(|i| glam::Vec3::from(positions[i as usize]));
-        let ids = if g == 0 {
-            [push(&mut acc, &mut group, &mut next, face_normal(p[0], p[1], p[2]).unwrap_or_default(), 0, u32::MAX); 3]
-        } else {
-            t.map(|i| {
-                let mut k = head[i as usize];
-                while k != u32::MAX && group[k as usize] != g {
-                    k = next[k as usize];
-                }
-                if k == u32::MAX {
-                    k = push(&mut acc, &mut group, &mut next, glam::Vec3::ZERO, g, head[i as usize]);
-                    head[i as usize] = k;
-                }
-                k
-            })
-        };
-        if let (Some(w), true) = (corner_weights(p), g != 0) {
-            (0..3).for_each(|k| acc[ids[k] as usize] += w[k]);
+        if g == 0 {
+            let sum = face_normal(p[0], p[1], p[2]).unwrap_or_default();
+            slots.push(Slot { sum, group: 0, next: u32::MAX });
+            index.push([slots.len() as u32 - 1; 3]);
+            continue;
+        }
+        let ids = t.map(|i| {
+            let mut k = head[i as usize];
+            while k != u32::MAX && slots[k as usize].group != g {
+                k = slots[k as usize].next;
+            }
+            if k == u32::MAX {
+                slots.push(Slot { sum: glam::Vec3::ZERO, group: g, next: head[i as usize] });
+                k = slots.len() as u32 - 1;
+                head[i as usize] = k;
+            }
+            k
+        });
+        if let Some(w) = corner_weights(p) {
+            (0..3).for_each(|k| slots[ids[k] as usize].sum += w[k]);
         }
         index.push(ids);
     }
     let mut fixed = 0;
-    let normals = acc
+    let normals = slots
         .into_iter()
-        .map(|n| {
-            unit_or_z(n).unwrap_or_else(|| {
+        .map(|s| {
+            unit_or_z(s.sum).unwrap_or_else(|| {
                 fixed += 1;
                 [0.0, 0.0, 1.0]
             })

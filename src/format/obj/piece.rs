@@ -149,8 +149,7 @@ impl<'a> Line<'a> {
     }
 
     fn float(&mut self, what: &str) -> std::result::Result<f32, String> {
-        let t = self.token().ok_or_else(|| format!("{what} has too few numbers"))?;
-        parse_f32(t).ok_or_else(|| format!("{what}: '{}' is not a number", String::from_utf8_lossy(t)))
+        self.optional_float(what)?.ok_or_else(|| format!("{what} has too few numbers"))
     }
 
     /// The next number if the line has one more token, `None` at its end.
