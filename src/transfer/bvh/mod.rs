@@ -70,26 +70,27 @@ impl Bvh {
         if n == 0 {
             return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
         }
-        let mut items: Vec<Item> =
-            (0..n).into_par_iter().map(|i| Item::of(positions, triangles[i], i as u32)).collect();
-        let bc = bounds_of(&items);
-        let (upper, ids) = if morton::applies(n) {
-            morton::build(&items, &bc.1)
-        } else {
-            let upper = Upper::range(sah::build_par(&mut items, 0, bc));
-            (upper, items.par_iter().map(|it| it.id).collect())
+        let item = |i: usize| Item::of(positions, triangles[i], i as u32);
+        let tri = |i: u32| {
+            let t = triangles[i as usize];
+            Tri { corners: t.map(|k| positions[k as usize]), index: index(i).unwrap_or(t) }
         };
+        if morton::applies(n) {
+            // Each range writes its triangles in leaf order as it ends, while they are cached:
+            // no array of items, no pass of its own over HIGH in leaf order.
+            let (upper, ids, tris) = morton::build(n, &item, &tri);
+            drop(triangles);
+            return Bvh { nodes: upper.collapse(), ids, tris };
+        }
+        let mut items: Vec<Item> = (0..n).into_par_iter().map(item).collect();
+        let bc = bounds_of(&items);
+        let upper = Upper::range(sah::build_par(&mut items, 0, bc));
+        let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         // Each array is dropped as soon as the next is made from it: the build's peak is what
         // bounds memory on a large HIGH.
         drop(items);
         let nodes = upper.collapse();
-        let tris = ids
-            .par_iter()
-            .map(|&i| {
-                let t = triangles[i as usize];
-                Tri { corners: t.map(|k| positions[k as usize]), index: index(i).unwrap_or(t) }
-            })
-            .collect();
+        let tris = ids.par_iter().map(|&i| tri(i)).collect();
         Bvh { nodes, ids, tris }
     }
 
@@ -207,13 +208,25 @@ pub(crate) mod tests {
         assert_eq!(one, build(3));
     }
 
-    /// Identical triangles (no centre spread) still end in small leaves.
+    /// Identical triangles (no centre spread) still end in small leaves, on their own and as a
+    /// pile among a large HIGH's others (more than a range of one Morton code holds); every
+    /// triangle is in one leaf, with its own corners.
     #[test]
     fn duplicates_split_by_count() {
         let t = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
-        let (bvh, _) = soup(&vec![t; 1000]);
-        let counts = || bvh.nodes.iter().flat_map(|n| n.count);
-        assert!(counts().all(|c| c as usize <= cost::MAX_LEAF * 2));
-        assert_eq!(counts().map(|c| c as usize).sum::<usize>(), 1000);
+        let mut large = grid_tris(200);
+        large.splice(5000..5000, vec![t.map(|p| p + Vec3A::new(3.5, 7.5, 9.0)); 1000]);
+        for tris in [vec![t; 1000], large] {
+            let (bvh, _) = soup(&tris);
+            let counts = || bvh.nodes.iter().flat_map(|n| n.count);
+            assert!(counts().all(|c| c as usize <= cost::MAX_LEAF * 2));
+            assert_eq!(counts().map(|c| c as usize).sum::<usize>(), tris.len());
+            for (k, &id) in bvh.ids.iter().enumerate() {
+                assert_eq!(bvh.corners(k), &tris[id as usize].map(|p| p.to_array()), "leaf-order triangle {k}");
+            }
+            if tris.len() >= morton::MORTON_MIN {
+                covered_once_and_nested(&tris);
+            }
+        }
     }
 }

@@ -8,7 +8,9 @@ use super::local::LOCAL;
 use super::node::Node;
 use super::range;
 use super::sah;
+use super::{Tri, PARALLEL_MIN};
 use glam::Vec3A;
+use std::mem::MaybeUninit;
 
 /// From this many triangles on, the upper levels are split here rather than by SAH.
 pub(super) const MORTON_MIN: usize = 64 * 1024;
@@ -34,31 +36,61 @@ pub(super) fn applies(n: usize) -> bool {
     (MORTON_MIN..1 << INDEX_BITS).contains(&n)
 }
 
-/// Builds the tree over `items` in the order of the Morton codes of their centres within
-/// `centres` (their centres' bounds); returns it and the items' ids in leaf order. The items are
-/// never gathered into that order: each range reads its own where they are.
-pub(super) fn build(items: &[Item], centres: &Aabb) -> (Upper, Vec<u32>) {
+/// Builds the tree over the `n` triangles whose items `item` gives, in the order of the Morton
+/// codes of their centres; returns it, the triangles' ids in leaf order and `tri` of each id in
+/// that order. The items are never gathered into that order: each range computes its own from
+/// the mesh, and writes its triangles in leaf order into their place.
+pub(super) fn build<I, T>(n: usize, item: &I, tri: &T) -> (Upper, Vec<u32>, Vec<Tri>)
+where
+    I: Fn(usize) -> Item + Sync,
+    T: Fn(u32) -> Tri + Sync,
+{
     use rayon::prelude::*;
-    let mut keys = morton_keys(items, centres);
-    let upper = build_upper(items, &mut keys, 0);
+    let centres = (0..n)
+        .into_par_iter()
+        .with_min_len(PARALLEL_MIN)
+        .fold(
+            || Aabb::EMPTY,
+            |mut c, i| {
+                c.grow(item(i).centre());
+                c
+            },
+        )
+        .reduce(
+            || Aabb::EMPTY,
+            |mut a, b| {
+                a.join(&b);
+                a
+            },
+        );
+    let mut keys = morton_keys(n, |i| item(i).centre(), &centres);
+    let mut tris: Vec<Tri> = Vec::with_capacity(n);
+    let upper = build_upper(&Mesh { item, tri }, &mut keys, &mut tris.spare_capacity_mut()[..n], 0);
+    // SAFETY: the ranges split the keys without gaps, the slots in step with them, and each
+    // range writes every slot of its own (`range`), so all `n` are written.
+    unsafe { tris.set_len(n) };
     // Each range has left its ids in leaf order where its keys were.
     let ids = keys.par_iter().map(|&k| k as u32).collect();
-    (upper, ids)
+    (upper, ids, tris)
+}
+
+/// What the ranges read the mesh through: a triangle's item, and its record in leaf order.
+struct Mesh<'a, I, T> {
+    item: &'a I,
+    tri: &'a T,
 }
 
 /// Each item's key (Morton code of its box's centre over the centres' bounds `c`, then its
 /// index), sorted.
-fn morton_keys(items: &[Item], c: &Aabb) -> Vec<u64> {
+fn morton_keys(n: usize, centre: impl Fn(usize) -> Vec3A + Sync, c: &Aabb) -> Vec<u64> {
     use rayon::prelude::*;
-    let n = items.len();
     let cells = (1u32 << AXIS_BITS) as f32;
     let extent = c.max - c.min;
     let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
-    let keys: Vec<u64> = items
-        .par_iter()
-        .enumerate()
-        .map(|(i, it)| {
-            let q = ((it.centre() - c.min) * scale).min(Vec3A::splat(cells - 1.0));
+    let keys: Vec<u64> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let q = ((centre(i) - c.min) * scale).min(Vec3A::splat(cells - 1.0));
             let code = spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2;
             code << INDEX_BITS | i as u64
         })
@@ -159,42 +191,58 @@ fn upper_bounds(u: &Upper) -> Aabb {
     Aabb { min: Vec3A::from(n.min), max: Vec3A::from(n.max) }
 }
 
-/// The upper levels over the items `keys` names (sorted, each a code above an index into
-/// `items`): each split where the codes' highest differing bit flips; ranges of [`SAH_RANGE`] or
-/// fewer (or of one code) are built by binned SAH. Leaves each key holding its item's id, in leaf
-/// order.
-fn build_upper(items: &[Item], keys: &mut [u64], offset: usize) -> Upper {
+/// The upper levels over the items `keys` names (sorted, each a code above an index into the
+/// mesh): each split where the codes' highest differing bit flips; ranges of [`SAH_RANGE`] or
+/// fewer (or of one code) are built by binned SAH. Leaves each key holding its item's id, and
+/// each slot of `out` its triangle, in leaf order.
+fn build_upper<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], out: &mut [MaybeUninit<Tri>], offset: usize) -> Upper
+where
+    I: Fn(usize) -> Item + Sync,
+    T: Fn(u32) -> Tri + Sync,
+{
     let code = |k: u64| k >> INDEX_BITS;
     let (first, last) = (code(keys[0]), code(keys[keys.len() - 1]));
     if keys.len() <= SAH_RANGE || first == last {
-        return Upper::range(range(items, keys, offset));
+        return Upper::range(range(mesh, keys, out, offset));
     }
     let bit = 63 - (first ^ last).leading_zeros();
     let mid = keys.partition_point(|&k| code(k) >> bit & 1 == 0);
     let (l, r) = keys.split_at_mut(mid);
+    let (lo, ro) = out.split_at_mut(mid);
     let (left, right) = if l.len() + r.len() < SERIAL_BELOW {
-        (build_upper(items, l, offset), build_upper(items, r, offset + mid))
+        (build_upper(mesh, l, lo, offset), build_upper(mesh, r, ro, offset + mid))
     } else {
-        rayon::join(|| build_upper(items, l, offset), || build_upper(items, r, offset + mid))
+        rayon::join(|| build_upper(mesh, l, lo, offset), || build_upper(mesh, r, ro, offset + mid))
     };
     let mut b = upper_bounds(&left);
     b.join(&upper_bounds(&right));
     Upper::Split(Node::inner(&b, 0), Box::new(left), Box::new(right))
 }
 
-/// The binary tree over the range of items `keys` names, starting at `offset` in leaf order.
-fn range(items: &[Item], keys: &mut [u64], offset: usize) -> Vec<Node> {
+/// The binary tree over the range of items `keys` names, starting at `offset` in leaf order;
+/// writes every slot of `out` (as many as `keys`).
+fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], out: &mut [MaybeUninit<Tri>], offset: usize) -> Vec<Node>
+where
+    I: Fn(usize) -> Item + Sync,
+    T: Fn(u32) -> Tri + Sync,
+{
     keys.iter_mut().for_each(|k| *k &= INDEX_MASK);
-    let mut nodes = Vec::with_capacity(keys.len() / 2 + 1);
-    if keys.len() <= LOCAL {
-        range::build_by_index(items, keys, offset, &mut nodes);
-        return nodes;
+    let nodes = if keys.len() <= LOCAL {
+        let mut nodes = Vec::with_capacity(keys.len() / 2 + 1);
+        range::build_by_index(mesh.item, keys, offset, &mut nodes);
+        nodes
+    } else {
+        // Many items with one code (a pile of duplicates): gathered, then split by count.
+        let mut gathered: Vec<Item> = keys.iter().map(|&k| (mesh.item)(k as usize)).collect();
+        let bc = bounds_of(&gathered);
+        let nodes = sah::build_par(&mut gathered, offset, bc);
+        keys.iter_mut().zip(&gathered).for_each(|(k, it)| *k = u64::from(it.id));
+        nodes
+    };
+    // The range's triangles were just read for their items: they are still in cache.
+    for (slot, &k) in out.iter_mut().zip(keys.iter()) {
+        slot.write((mesh.tri)(k as u32));
     }
-    // Many items with one code (a pile of duplicates): gathered, then split by count.
-    let mut gathered: Vec<Item> = keys.iter().map(|&k| items[k as usize]).collect();
-    let bc = bounds_of(&gathered);
-    let nodes = sah::build_par(&mut gathered, offset, bc);
-    keys.iter_mut().zip(&gathered).for_each(|(k, it)| *k = u64::from(it.id));
     nodes
 }
 
@@ -244,13 +292,14 @@ mod tests {
             .collect();
         let (_, c) = bounds_of(&items);
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
-        let keys = one.install(|| morton_keys(&items, &c));
+        let centre = |i: usize| items[i].centre();
+        let keys = one.install(|| morton_keys(items.len(), centre, &c));
         assert!(keys.windows(2).all(|w| w[0] < w[1]));
         let mut ids: Vec<u64> = keys.iter().map(|k| k & INDEX_MASK).collect();
         ids.sort_unstable();
         assert!(ids.iter().enumerate().all(|(i, &k)| k == i as u64), "every item once");
         let three = rayon::ThreadPoolBuilder::new().num_threads(3).build().expect("pool");
-        assert_eq!(three.install(|| morton_keys(&items, &c)), keys);
+        assert_eq!(three.install(|| morton_keys(items.len(), centre, &c)), keys);
     }
 
     #[test]

@@ -24,14 +24,14 @@ pub(super) fn build(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, bc
     });
 }
 
-/// [`build`] over the items `all[k]` for each `k` in `ids` (at most [`LOCAL`]), read where they
-/// are rather than gathered first; leaves `ids` holding the items' ids in leaf order.
-pub(super) fn build_by_index(all: &[Item], ids: &mut [u64], offset: usize, nodes: &mut Vec<Node>) {
+/// [`build`] over the items `item(k)` for each `k` in `ids` (at most [`LOCAL`]), made where
+/// they are rather than gathered first; leaves `ids` holding the items' ids in leaf order.
+pub(super) fn build_by_index(item: impl Fn(usize) -> Item, ids: &mut [u64], offset: usize, nodes: &mut Vec<Node>) {
     debug_assert!((1..=LOCAL).contains(&ids.len()));
     Local::with(|l| {
         let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
         for (i, &k) in ids.iter().enumerate() {
-            l.set(i, all[k as usize]);
+            l.set(i, item(k as usize));
             b.join(&l.bounds[i]);
             c.grow(l.centre[i]);
         }
