@@ -64,12 +64,30 @@ pub enum Setting {
     Normal,
     /// The HIGH meshes whose surface is baked onto LOW.
     High,
+    /// The KTX2 codec's effort or quality: UASTC's pack level, ETC1S's quality.
+    Ktx2Quality,
+    /// The cap of specular antialiasing's roughness widening, in GGX alpha.
+    SpecularAaThreshold,
+    /// A preview camera's vertical field of view, in degrees.
+    Fov,
+    /// A preview camera's turn about the vertical axis, in degrees.
+    Yaw,
+    /// A preview camera's tilt, in degrees.
+    Pitch,
+    /// A preview camera's distance from the scene's centre.
+    Distance,
+    /// A preview's ambient light.
+    Ambient,
+    /// A preview's specular strength.
+    Specular,
+    /// A preview's specular exponent.
+    Shininess,
 }
 
 impl Setting {
     /// Every setting, in declaration order (a new variant goes here too: the front ends' tests
     /// check each has a name).
-    pub const EVERY: [Setting; 23] = [
+    pub const EVERY: [Setting; 32] = [
         Setting::Convention,
         Setting::Material,
         Setting::MaxPixels,
@@ -93,6 +111,15 @@ impl Setting {
         Setting::Height,
         Setting::Normal,
         Setting::High,
+        Setting::Ktx2Quality,
+        Setting::SpecularAaThreshold,
+        Setting::Fov,
+        Setting::Yaw,
+        Setting::Pitch,
+        Setting::Distance,
+        Setting::Ambient,
+        Setting::Specular,
+        Setting::Shininess,
     ];
 
     /// The neutral name: lower case, words joined by `_` (`max_pixels`).
@@ -121,6 +148,15 @@ impl Setting {
             Setting::Height => "height",
             Setting::Normal => "normal",
             Setting::High => "high",
+            Setting::Ktx2Quality => "ktx2_quality",
+            Setting::SpecularAaThreshold => "specular_aa_threshold",
+            Setting::Fov => "fov",
+            Setting::Yaw => "yaw",
+            Setting::Pitch => "pitch",
+            Setting::Distance => "distance",
+            Setting::Ambient => "ambient",
+            Setting::Specular => "specular",
+            Setting::Shininess => "shininess",
         }
     }
 }
@@ -437,6 +473,6 @@ mod tests {
     fn every_setting_has_its_own_name() {
         let names: std::collections::BTreeSet<&str> = Setting::EVERY.iter().map(|s| s.name()).collect();
         assert_eq!(names.len(), Setting::EVERY.len());
-        assert!(names.iter().all(|n| n.chars().all(|c| c.is_ascii_lowercase() || c == '_')));
+        assert!(names.iter().all(|n| n.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')));
     }
 }

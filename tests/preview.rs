@@ -540,3 +540,20 @@ fn a_flat_plane_is_previewed_face_on_and_the_report_names_the_view() {
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["camera"], json!({ "yaw": 0.0, "pitch": 0.0, "view": "front" }), "{report}");
 }
+
+/// The library's check of the camera's numbers, worded in the command line's flags.
+#[test]
+fn a_bad_camera_number_names_its_flag() {
+    let spot = fixture("spot/spot.obj").to_string_lossy().into_owned();
+    for (flag, value, words) in [
+        ("--fov", "0", "preview: --fov 0 is not a usable value: give degrees between 0 and 180"),
+        ("--distance=-2", "", "preview: --distance -2 must be positive"),
+    ] {
+        let mut args = vec!["preview", &spot, "-o", "/nonexistent/p.png", flag];
+        args.extend([value].into_iter().filter(|v| !v.is_empty()));
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert_eq!(err.trim_end(), format!("bumpbake: {words}"), "{err}");
+    }
+}

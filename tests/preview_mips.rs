@@ -277,3 +277,66 @@ fn specular_aa_keeps_the_brightness_of_random_bumps_against_an_hdr_truth() {
     assert!((rb - 1.0).abs() > 0.04, "box mips brightness {rb}");
     assert!(s.psnr_db.unwrap() > b.psnr_db.unwrap() + 2.0, "PSNR: specular AA {s:?} vs box {b:?}");
 }
+
+/// The camera's and the shading's numbers are checked by the library, the setting and value
+/// given as data for each front end to word (the command line's flags: `tests/preview.rs`).
+#[test]
+fn camera_and_shading_numbers_are_refused_by_the_library() {
+    use bumpbake::error::{Neutral, Setting};
+    use bumpbake::preview::CameraSpec;
+    let cam = |c: CameraSpec| Options { camera: c, ..Default::default() };
+    let par = |p: Params| Options { params: p, ..Default::default() };
+    let refused = [
+        (
+            cam(CameraSpec { fov: 0.0, ..Default::default() }),
+            Setting::Fov,
+            "preview: fov=0 is not a usable value: give degrees between 0 and 180",
+        ),
+        (
+            cam(CameraSpec { fov: 180.0, ..Default::default() }),
+            Setting::Fov,
+            "preview: fov=180 is not a usable value: give degrees between 0 and 180",
+        ),
+        (
+            cam(CameraSpec { yaw: f32::NAN, ..Default::default() }),
+            Setting::Yaw,
+            "preview: yaw=NaN is not a usable value",
+        ),
+        (
+            cam(CameraSpec { pitch: f32::INFINITY, ..Default::default() }),
+            Setting::Pitch,
+            "preview: pitch=inf is not a usable value",
+        ),
+        (
+            cam(CameraSpec { distance: Some(0.0), ..Default::default() }),
+            Setting::Distance,
+            "preview: distance=0 must be positive",
+        ),
+        (
+            par(Params { ambient: -0.1, ..Default::default() }),
+            Setting::Ambient,
+            "preview: ambient=-0.1 is not a usable value",
+        ),
+        (
+            par(Params { specular: f32::NAN, ..Default::default() }),
+            Setting::Specular,
+            "preview: specular=NaN is not a usable value",
+        ),
+        (
+            par(Params { shininess: -1.0, ..Default::default() }),
+            Setting::Shininess,
+            "preview: shininess=-1 is not a usable value",
+        ),
+    ];
+    for (o, setting, words) in refused {
+        let e = o.check().unwrap_err();
+        assert!(
+            matches!(&e, bumpbake::Error::Usage { setting: Some(s), value: Some(_), .. } if *s == setting),
+            "{e:?}"
+        );
+        assert_eq!(e.worded(&Neutral), words);
+    }
+    let fine = cam(CameraSpec { yaw: -720.0, pitch: 89.0, distance: Some(0.01), fov: 179.0 });
+    fine.check().unwrap();
+    par(Params { ambient: 0.0, specular: 0.0, shininess: 0.0, ..Default::default() }).check().unwrap();
+}

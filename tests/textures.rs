@@ -347,3 +347,73 @@ fn bake_from_ships_the_baked_map() {
     assert!(mean < 3.0, "level 0 is the baked map within the codec's error: mean {mean:.2}°");
     assert!(baked.pixels().any(|p| p.0[0].abs_diff(128) > 20), "the baked map is not flat");
 }
+
+/// What the encoder would clamp without a word is refused by the library, whichever front end
+/// calls it, with the setting and the value given as data and worded by the caller: the command
+/// line's flags here, the Python package's keywords in `python/tests/test_files.py`.
+#[test]
+fn codec_settings_are_refused_by_the_library_as_data() {
+    use bumpbake::error::{Neutral, Setting};
+    use bumpbake::format::image::ktx2::Codec;
+    use bumpbake::textures::{encode_ktx2, EncodeOptions};
+    let with = |codec| EncodeOptions { codec, ..Default::default() };
+    let refused = [
+        (
+            with(Codec::Uastc { level: 5, rdo: None }),
+            Setting::Ktx2Quality,
+            "5",
+            "ktx2_quality=5: UASTC levels are 0 to 4",
+        ),
+        (with(Codec::Etc1s { quality: 0 }), Setting::Ktx2Quality, "0", "ktx2_quality=0: ETC1S quality is 1 to 255"),
+        (
+            with(Codec::Etc1s { quality: 256 }),
+            Setting::Ktx2Quality,
+            "256",
+            "ktx2_quality=256: ETC1S quality is 1 to 255",
+        ),
+        (
+            EncodeOptions { threshold: 1.5, ..Default::default() },
+            Setting::SpecularAaThreshold,
+            "1.5",
+            "specular_aa_threshold=1.5: give a number from 0 to 1",
+        ),
+        (
+            EncodeOptions { threshold: f32::NAN, ..Default::default() },
+            Setting::SpecularAaThreshold,
+            "NaN",
+            "specular_aa_threshold=NaN: give a number from 0 to 1",
+        ),
+    ];
+    let scene = bumpbake::format::read(&torus(), &Default::default()).unwrap();
+    for (o, setting, value, words) in refused {
+        let e = o.check().unwrap_err();
+        match &e {
+            bumpbake::Error::Usage { setting: s, value: v, .. } => {
+                assert_eq!((*s, v.as_deref()), (Some(setting), Some(value)), "{words}")
+            }
+            other => panic!("{words}: {other:?}"),
+        }
+        assert_eq!(e.worded(&Neutral), words);
+        // The library's own entry refuses it before touching the scene.
+        let mut s = scene.clone();
+        assert!(encode_ktx2(&mut s, &o).is_err(), "{words}");
+        assert_eq!(s.json, scene.json, "{words}: the scene was changed");
+    }
+    for codec in (0..=4)
+        .map(|level| Codec::Uastc { level, rdo: None })
+        .chain([1, 128, 255].map(|quality| Codec::Etc1s { quality }))
+    {
+        with(codec).check().unwrap();
+    }
+    for lambda in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        assert!(with(Codec::Uastc { level: 2, rdo: Some(lambda) }).check().is_err(), "rdo {lambda}");
+    }
+    with(Codec::Uastc { level: 2, rdo: Some(1.0) }).check().unwrap();
+    for threshold in [0.0, 0.2, 1.0] {
+        EncodeOptions { threshold, ..Default::default() }.check().unwrap();
+    }
+    // On the command line, in its flags.
+    let out = run(&["textures", &torus().to_string_lossy(), "-o", "/nonexistent/o.glb", "--ktx2-quality", "9"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--ktx2-quality 9: UASTC levels are 0 to 4"), "{err}");
+}

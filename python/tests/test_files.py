@@ -112,6 +112,22 @@ def test_file_call_options_are_checked_by_the_command_lines_parser(fixtures, opt
     assert keyword in str(e.value) and "--" not in str(e.value), str(e.value)
 
 
+@pytest.mark.parametrize(
+    "options, words",
+    [
+        ({"ktx2_quality": 9}, "ktx2_quality=9: UASTC levels are 0 to 4"),
+        ({"ktx2": "etc1s", "ktx2_quality": 0}, "ktx2_quality=0: ETC1S quality is 1 to 255"),
+        ({"specular_aa_threshold": 3}, "specular_aa_threshold=3: give a number from 0 to 1"),
+    ],
+)
+def test_the_librarys_value_checks_name_the_keyword(tmp_path, fixtures, options, words):
+    out = tmp_path / "o.glb"
+    with pytest.raises(bumpbake.UsageError) as e:
+        bumpbake.textures(fixtures / "bake/torus.obj", out, **options)
+    assert words in str(e.value) and "--" not in str(e.value), str(e.value)
+    assert not out.exists()
+
+
 def test_the_command_lines_own_checks_are_worded_in_keywords(tmp_path, fixtures):
     with pytest.raises(bumpbake.UsageError) as e:
         bumpbake.bake_from(fixtures / "bake/torus.obj", fixtures / "bake/torus.obj", tmp_path / "o.glb", samples=99)

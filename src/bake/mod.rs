@@ -86,6 +86,8 @@ pub fn run(job: &BakeJob) -> Result<BakeReport> {
 /// [`run`] with HIGH meshes already in memory for a [`MapSource::Transfer`] job
 /// ([`crate::transfer::bake_from`]).
 pub fn run_from(job: &BakeJob, high: Vec<crate::transfer::high::HighMesh>) -> Result<BakeReport> {
+    // Settings refused before any work, not after the bake.
+    job.textures.as_ref().map(|o| o.check()).transpose()?;
     let mut t = Timings::default();
     let mut scene = t.time("read", || crate::format::read(&job.mesh, &job.read))?;
     let mut deps = scene.dependencies();

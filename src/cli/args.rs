@@ -127,16 +127,11 @@ pub struct Ktx2Args {
 }
 
 impl Ktx2Args {
-    pub fn codec(&self) -> Result<Codec> {
+    /// The codec asked for; its range is checked where it is used (`Codec::check`).
+    pub fn codec(&self) -> Codec {
         match (self.ktx2.unwrap_or(Ktx2Codec::Uastc), self.ktx2_quality) {
-            (Ktx2Codec::Uastc, q) => match q.unwrap_or(nm::DEFAULT_UASTC_LEVEL) {
-                level @ 0..=4 => Ok(Codec::Uastc { level, rdo: None }),
-                q => Err(Error::usage(format!("--ktx2-quality {q}: UASTC levels are 0 to 4"))),
-            },
-            (Ktx2Codec::Etc1s, q) => match q.unwrap_or(nm::DEFAULT_ETC1S_QUALITY) {
-                quality @ 1..=255 => Ok(Codec::Etc1s { quality }),
-                q => Err(Error::usage(format!("--ktx2-quality {q}: ETC1S quality is 1 to 255"))),
-            },
+            (Ktx2Codec::Uastc, q) => Codec::Uastc { level: q.unwrap_or(nm::DEFAULT_UASTC_LEVEL), rdo: None },
+            (Ktx2Codec::Etc1s, q) => Codec::Etc1s { quality: q.unwrap_or(nm::DEFAULT_ETC1S_QUALITY) },
         }
     }
 
@@ -171,17 +166,16 @@ pub struct TextureEncodeArgs {
 }
 
 impl TextureEncodeArgs {
+    /// The options asked for, checked (`EncodeOptions::check`) before any work.
     pub fn options(&self) -> Result<EncodeOptions> {
-        let threshold = self.specular_aa_threshold.unwrap_or(DEFAULT_THRESHOLD);
-        if !(0.0..=1.0).contains(&threshold) {
-            return Err(Error::usage(format!("--specular-aa-threshold {threshold}: give a number from 0 to 1")));
-        }
-        Ok(EncodeOptions {
-            codec: self.ktx2.codec()?,
+        let o = EncodeOptions {
+            codec: self.ktx2.codec(),
             fallback: self.ktx2_fallback,
             specular_aa: !self.no_specular_aa,
-            threshold,
-        })
+            threshold: self.specular_aa_threshold.unwrap_or(DEFAULT_THRESHOLD),
+        };
+        o.check()?;
+        Ok(o)
     }
 
     /// The first option given that only KTX2 output reads.

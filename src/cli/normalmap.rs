@@ -109,7 +109,8 @@ fn out_ext(args: &Args) -> Result<String> {
 
 pub fn run(args: Args) -> Result<u8> {
     let outputs = super::args::outputs(&args.heights, &args.output, &args.batch.out_dir, &out_ext(&args)?)?;
-    let ktx2 = args.ktx2.codec()?;
+    let ktx2 = args.ktx2.codec();
+    ktx2.check()?;
     let options =
         Options { strength: strength(&args)?, filter: args.filter.into(), wrap: args.wrap.into(), invert: args.invert };
     let convert = |input: &Path, output: &Path| -> Result<Convert> {

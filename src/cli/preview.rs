@@ -172,23 +172,6 @@ pub fn run(a: Args) -> Result<u8> {
     if a.output.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("png")) != Some(true) {
         return Err(Error::usage(format!("{}: the preview is written as PNG; name it .png", a.output.display())));
     }
-    for (what, v) in [
-        ("--fov", a.fov),
-        ("--ambient", a.ambient),
-        ("--specular", a.specular),
-        ("--shininess", a.shininess),
-        ("--yaw", a.yaw.unwrap_or(0.0)),
-        ("--pitch", a.pitch.unwrap_or(0.0)),
-    ] {
-        if !v.is_finite() || (what != "--yaw" && what != "--pitch" && v < 0.0) {
-            return Err(Error::usage(format!("preview: {what} {v} is not a usable value")));
-        }
-    }
-    if let Some(d) = a.distance {
-        if !(d.is_finite() && d > 0.0) {
-            return Err(Error::usage(format!("preview: --distance {d} must be positive")));
-        }
-    }
     let lights =
         a.light.iter().map(|l| Light::parse(l)).collect::<std::result::Result<Vec<_>, _>>().map_err(Error::usage)?;
     let view = match a.view {

@@ -355,6 +355,9 @@ pub struct Converted {
 /// the height plane plus the compressed file.
 pub fn convert_file(c: &Convert, progress: &Reporter) -> Result<Converted> {
     let format = OutputFormat::from_path(&c.output)?;
+    if format == OutputFormat::Ktx2 {
+        c.ktx2.check()?;
+    }
     let mut t = Timings::default();
     let height = t.time("decode", || load_height(&c.input, c.channel, c.max_pixels))?;
     // Judged on the texels as written, as `validate` judges them.

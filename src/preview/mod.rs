@@ -104,6 +104,7 @@ impl Options {
             let setting = if self.width == 0 || self.height == 0 { Setting::Size } else { Setting::Ssaa };
             return Err(crate::Error::setting(setting, None, msg.text(format!(" between 1 and {MAX_SSAA}"))));
         }
+        self.check_numbers()?;
         let n = self.width as u64 * self.height as u64;
         let row = self.width as u64 * (self.ssaa as u64).pow(2);
         if n > MAX_SAMPLES || row > MAX_SAMPLES {
@@ -111,6 +112,35 @@ impl Options {
                 Words::from(format!("preview: {}x{} with ", self.width, self.height)).given(Setting::Ssaa, self.ssaa);
             let msg = msg.text(format!(" is {n} pixels and {row} samples a row; the limit is {MAX_SAMPLES}"));
             return Err(crate::Error::setting(Setting::Size, Some(format!("{}x{}", self.width, self.height)), msg));
+        }
+        Ok(())
+    }
+}
+
+impl Options {
+    /// The camera's and the shading's numbers: finite, and what each measures can be.
+    fn check_numbers(&self) -> Result<()> {
+        let (c, p) = (&self.camera, &self.params);
+        let d = c.distance.unwrap_or(1.0);
+        let numbers = [
+            (
+                Setting::Fov,
+                c.fov,
+                c.fov > 0.0 && c.fov < 180.0,
+                "is not a usable value: give degrees between 0 and 180",
+            ),
+            (Setting::Yaw, c.yaw, true, "is not a usable value"),
+            (Setting::Pitch, c.pitch, true, "is not a usable value"),
+            (Setting::Distance, d, d > 0.0, "must be positive"),
+            (Setting::Ambient, p.ambient, p.ambient >= 0.0, "is not a usable value"),
+            (Setting::Specular, p.specular, p.specular >= 0.0, "is not a usable value"),
+            (Setting::Shininess, p.shininess, p.shininess >= 0.0, "is not a usable value"),
+        ];
+        for (s, v, ok, why) in numbers {
+            if !(v.is_finite() && ok) {
+                let msg = Words::from("preview: ").given(s, v).text(format!(" {why}"));
+                return Err(crate::Error::setting(s, Some(v.to_string()), msg));
+            }
         }
         Ok(())
     }

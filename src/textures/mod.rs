@@ -8,7 +8,7 @@
 
 pub mod roughness;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Setting, Words};
 use crate::format::image::ktx2::{self, Codec, Level};
 use crate::format::image::{self as img, Kind};
 use crate::format::{self, WriteOptions, WriteStats};
@@ -45,6 +45,19 @@ impl Default for EncodeOptions {
             specular_aa: true,
             threshold: DEFAULT_THRESHOLD,
         }
+    }
+}
+
+impl EncodeOptions {
+    /// Refuses a codec setting the encoder does not have, or a threshold outside 0 to 1.
+    pub fn check(&self) -> Result<()> {
+        self.codec.check()?;
+        if !(0.0..=1.0).contains(&self.threshold) {
+            let s = Setting::SpecularAaThreshold;
+            let msg = Words::new().given(s, self.threshold).text(": give a number from 0 to 1");
+            return Err(Error::setting(s, Some(self.threshold.to_string()), msg));
+        }
+        Ok(())
     }
 }
 
@@ -150,6 +163,7 @@ fn encode_normal(scene: &mut Scene, image: usize, bytes: &[u8], codec: Codec) ->
 /// Re-encodes every material's normal texture as KTX2 and, with `opts.specular_aa`, gives it a
 /// widened metallic-roughness texture. Textures and images only these used are dropped.
 pub fn encode_ktx2(scene: &mut Scene, opts: &EncodeOptions) -> Result<TexturesReport> {
+    opts.check()?;
     let mut report = TexturesReport {
         codec: codec_words(opts.codec),
         fallback: opts.fallback,
@@ -273,6 +287,7 @@ pub struct TexturesRun {
 }
 
 pub fn run(job: &TexturesJob) -> Result<TexturesRun> {
+    job.options.check()?;
     let mut t = Timings::default();
     let mut scene = t.time("read", || crate::format::read(&job.input, &job.read))?;
     let deps = scene.dependencies();

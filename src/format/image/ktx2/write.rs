@@ -25,6 +25,31 @@ pub enum Codec {
     Etc1s { quality: u32 },
 }
 
+impl Codec {
+    /// Refuses a level or quality the encoder does not have, which it would clamp without a
+    /// word; an RDO lambda must be a positive number.
+    pub fn check(&self) -> crate::Result<()> {
+        use crate::error::{Error, Setting, Words};
+        let (q, range, what) = match *self {
+            Codec::Uastc { level, .. } => (level, 0..=basis_universal::UASTC_QUALITY_MAX, "UASTC levels are"),
+            Codec::Etc1s { quality } => {
+                (quality, basis_universal::ETC1S_QUALITY_MIN..=basis_universal::ETC1S_QUALITY_MAX, "ETC1S quality is")
+            }
+        };
+        if !range.contains(&q) {
+            let (lo, hi) = (range.start(), range.end());
+            let msg = Words::new().given(Setting::Ktx2Quality, q).text(format!(": {what} {lo} to {hi}"));
+            return Err(Error::setting(Setting::Ktx2Quality, Some(q.to_string()), msg));
+        }
+        match *self {
+            Codec::Uastc { rdo: Some(l), .. } if !(l.is_finite() && l > 0.0) => {
+                Err(Error::usage(format!("UASTC's rate-distortion lambda {l} is not a positive number")))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
 /// The largest side the Basis Universal encoder takes (`BASISU_MAX_SUPPORTED_TEXTURE_DIMENSION`).
 pub const MAX_SIDE: u32 = 16384;
 
