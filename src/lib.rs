@@ -42,4 +42,7 @@ pub mod timings;
 pub mod transfer;
 pub mod validate;
 
+#[cfg(test)]
+mod test_rng;
+
 pub use error::{Error, Result};

@@ -367,15 +367,8 @@ mod tests {
     /// as a plain map over the corners in order numbers them.
     #[test]
     fn vertices_come_in_first_use_order() {
-        let mut x = 0x2545_f491u32;
-        let pos: Vec<[f32; 3]> = (0..5000)
-            .map(|_| {
-                x ^= x << 13;
-                x ^= x >> 17;
-                x ^= x << 5;
-                [(x % 300) as f32, 1.0, 0.0]
-            })
-            .collect();
+        let mut x = crate::test_rng::XorShift32(0x2545_f491);
+        let pos: Vec<[f32; 3]> = (0..5000).map(|_| [(x.next() % 300) as f32, 1.0, 0.0]).collect();
         let p = weld(vec![("POSITION".into(), Stream::from_f32("VEC3", &pos))], vec![], 4);
         let mut seen = std::collections::HashMap::new();
         let want: Vec<u32> = pos

@@ -144,11 +144,9 @@ fn floats_are_exactly_what_str_parse_gives() {
         }
     }
     // Every f32 midpoint neighbourhood and random decimals of every length.
-    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut rng = crate::test_rng::XorShift64(0x9E37_79B9_7F4A_7C15);
     for _ in 0..40_000 {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
+        let x = rng.next();
         let f = f32::from_bits(x as u32 & 0x7F7F_FFFF);
         let mid = (f as f64 + f32::from_bits(f.to_bits() + 1) as f64) / 2.0;
         let digits = (x >> 40) as usize % 12 + 1;

@@ -254,13 +254,11 @@ mod tests {
     /// order, as the bucket pass leaves them.
     #[test]
     fn radix_low_sorts_as_the_whole_key() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::test_rng::XorShift64(0x9e37_79b9_7f4a_7c15);
         for n in [1, 63, 64, 1000, 5000] {
             let mut keys: Vec<u64> = (0..n as u64)
                 .map(|i| {
-                    x ^= x << 13;
-                    x ^= x >> 7;
-                    x ^= x << 17;
+                    let x = rng.next();
                     // Few codes, so that many keys share one and their indices decide.
                     (((x % 97) << 5) | (x % 3)) << INDEX_BITS | i
                 })
@@ -277,13 +275,8 @@ mod tests {
     #[test]
     fn keys_come_sorted() {
         use super::super::bounds::bounds_of;
-        let mut x = 0x2545_f491u32;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            (x % 10_000) as f32 / 10_000.0
-        };
+        let mut x = crate::test_rng::XorShift32(0x2545_f491);
+        let mut next = || (x.next() % 10_000) as f32 / 10_000.0;
         let items: Vec<Item> = (0..50_000u32)
             .map(|id| {
                 let p = [next().powi(3), next(), (next() * 8.0).floor() / 8.0];

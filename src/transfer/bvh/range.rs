@@ -136,16 +136,11 @@ mod tests {
     /// The branch-free partition leaves the order of the swaps it stands for.
     #[test]
     fn partition_as_the_swaps_leave() {
-        let mut x = 0x2545_f491u32;
+        let mut x = crate::test_rng::XorShift32(0x2545_f491);
         for n in [1, 2, 17, 100, 256] {
             for k in 0..=BINS {
                 let mut which = [0u8; LOCAL];
-                which.iter_mut().take(n).for_each(|w| {
-                    x ^= x << 13;
-                    x ^= x >> 17;
-                    x ^= x << 5;
-                    *w = (x % BINS as u32) as u8;
-                });
+                which.iter_mut().take(n).for_each(|w| *w = (x.next() % BINS as u32) as u8);
                 let mut want: Vec<u8> = (0..n).map(|i| i as u8).collect();
                 let mut i = 0;
                 for (j, &w) in which.iter().enumerate().take(n) {
