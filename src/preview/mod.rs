@@ -115,9 +115,7 @@ impl Options {
         }
         Ok(())
     }
-}
 
-impl Options {
     /// The camera's and the shading's numbers: finite, and what each measures can be.
     fn check_numbers(&self) -> Result<()> {
         let (c, p) = (&self.camera, &self.params);

@@ -64,19 +64,25 @@ impl Item {
 /// The items' bounds and their centres' bounds (on every core for a large range: min and max
 /// give the same boxes in any grouping).
 pub(super) fn bounds_of(items: &[Item]) -> (Aabb, Aabb) {
+    bounds_by(items.len(), |i| items[i])
+}
+
+/// [`bounds_of`] the `n` items `item` gives, made where they are needed rather than read from
+/// an array.
+pub(super) fn bounds_by(n: usize, item: impl Fn(usize) -> Item + Sync) -> (Aabb, Aabb) {
     use rayon::prelude::*;
-    let one = |items: &[Item]| {
+    let one = |r: std::ops::Range<usize>| {
         let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
-        for it in items {
+        for it in r.map(&item) {
             b.join(&it.bounds());
             c.grow(it.centre());
         }
         (b, c)
     };
-    if items.len() < PARALLEL_MIN * 4 {
-        return one(items);
+    if n < PARALLEL_MIN * 4 {
+        return one(0..n);
     }
-    items.par_chunks(PARALLEL_MIN).map(one).reduce(
+    (0..n.div_ceil(PARALLEL_MIN)).into_par_iter().map(|k| one(k * PARALLEL_MIN..n.min((k + 1) * PARALLEL_MIN))).reduce(
         || (Aabb::EMPTY, Aabb::EMPTY),
         |(mut b, mut c), (b2, c2)| {
             b.join(&b2);

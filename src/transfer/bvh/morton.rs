@@ -2,13 +2,13 @@
 //! over every item per level. Binned SAH builds only ranges of [`SAH_RANGE`] or fewer, whose
 //! items fit in a core's cache.
 
-use super::bounds::{bounds_of, Aabb, Item};
+use super::bounds::{bounds_by, bounds_of, Aabb, Item};
 use super::collapse::Upper;
 use super::local::LOCAL;
 use super::node::Node;
 use super::range;
 use super::sah;
-use super::{Tri, PARALLEL_MIN};
+use super::Tri;
 use glam::Vec3A;
 use std::mem::MaybeUninit;
 
@@ -46,23 +46,7 @@ where
     T: Fn(u32) -> Tri + Sync,
 {
     use rayon::prelude::*;
-    let centres = (0..n)
-        .into_par_iter()
-        .with_min_len(PARALLEL_MIN)
-        .fold(
-            || Aabb::EMPTY,
-            |mut c, i| {
-                c.grow(item(i).centre());
-                c
-            },
-        )
-        .reduce(
-            || Aabb::EMPTY,
-            |mut a, b| {
-                a.join(&b);
-                a
-            },
-        );
+    let (_, centres) = bounds_by(n, item);
     let mut keys = morton_keys(n, |i| item(i).centre(), &centres);
     let mut tris: Vec<Tri> = Vec::with_capacity(n);
     let upper = build_upper(&Mesh { item, tri }, &mut keys, &mut tris.spare_capacity_mut()[..n], 0);
