@@ -77,7 +77,7 @@ impl Hit {
 ///
 /// Corners are read by axis straight from `v` (`v[i][k]` is one load): a vector register indexed
 /// by a run-time axis goes through memory, and that store and reload cost more than the test.
-#[inline]
+#[inline(always)]
 pub fn intersect(ray: &Ray, v: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
     let [kx, ky, kz] = ray.k;
     let [sx, sy, sz] = ray.shear;
@@ -144,20 +144,36 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -
     if bvh.is_empty() {
         return None;
     }
-    let mut best: Option<Hit> = None;
-    let (mut lo, mut hi) = (-back, front);
     let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
     let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
     // A component so small that its reciprocal overflows counts as none: the ray then stays in
     // the slab it starts in (or out of it) however far it goes.
     let flat = ray.inv.to_array().map(|x| x.is_infinite());
     let boxes = Boxes { o, inv, flat };
-    let nothing = Todo { child: 0, count: 0, gap: 0.0 };
-    let stack = &mut stack.0;
+    // Nearly every ray has a part of every axis: their walk leaves out the test for one that
+    // has none.
+    if flat.contains(&true) {
+        walk::<true>(bvh, ray, &boxes, (-back, front), &mut stack.0)
+    } else {
+        walk::<false>(bvh, ray, &boxes, (-back, front), &mut stack.0)
+    }
+}
+
+/// [`nearest`]'s walk, from the root, over `(lo, hi)`; `FLAT` when the ray has no part of some
+/// axis.
+#[inline(always)]
+fn walk<const FLAT: bool>(
+    bvh: &Bvh,
+    ray: &Ray,
+    boxes: &Boxes,
+    (mut lo, mut hi): (f32, f32),
+    stack: &mut Vec<Todo>,
+) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
     stack.clear();
-    let mut todo = nothing;
+    let mut todo = Todo { child: 0, count: 0, gap: 0.0 };
     loop {
-        if let Some(next) = visit(bvh, ray, todo, &boxes, &mut lo, &mut hi, &mut best, stack) {
+        if let Some(next) = visit::<FLAT>(bvh, ray, todo, boxes, &mut lo, &mut hi, &mut best, stack) {
             todo = next;
             continue;
         }
@@ -198,7 +214,7 @@ struct Boxes {
 /// first, except the nearest, which is returned to be visited next.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn visit(
+fn visit<const FLAT: bool>(
     bvh: &Bvh,
     ray: &Ray,
     todo: Todo,
@@ -228,7 +244,7 @@ fn visit(
     let n = &bvh.nodes[todo.child as usize];
     let Boxes { o, inv, flat } = boxes;
     let slab = |a: usize| {
-        if flat[a] {
+        if FLAT && flat[a] {
             // Faces included: a ray lying in a face is in the box. Outside, an empty part whose
             // ends stay finite through the margin below.
             let inside = n.min[a].cmple(o[a]) & n.max[a].cmpge(o[a]);
