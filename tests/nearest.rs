@@ -14,7 +14,7 @@
 //! for a ray lying in a box's face loses the box (the last two tests hold one case of each).
 
 use bumpbake::transfer::bvh::Bvh;
-use bumpbake::transfer::raycast::{intersect, nearest, nearest_each, Hit, Query, Ray, Stack};
+use bumpbake::transfer::raycast::{intersect, nearest, Hit, Ray, Stack};
 use glam::Vec3A;
 use proptest::prelude::*;
 
@@ -303,33 +303,7 @@ fn check(pts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[RaySpec]) -> Result<usize,
             want
         );
     }
-    side_by_side(&bvh, pts, tris, rays)?;
     Ok(hits)
-}
-
-/// The rays three at a time, side by side with each other and with a query into an empty tree
-/// or none, in every place in turn: each gets the hit it gets alone.
-fn side_by_side(bvh: &Bvh, pts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[RaySpec]) -> Result<(), TestCaseError> {
-    let empty = Bvh::build(&[], Vec::new());
-    let made: Vec<(Ray, f32, f32)> = rays.iter().filter_map(|s| Some((make_ray(pts, tris, s)?, s.2, s.3))).collect();
-    let mut stacks: [Stack; 4] = Default::default();
-    let hit_bits = |h: Option<Hit>| h.map(|h| (h.id, h.slot, h.t.to_bits(), h.bary.map(f32::to_bits)));
-    for (k, group) in made.chunks(3).enumerate() {
-        let mut queries: [Option<Query>; 4] = [None; 4];
-        for (i, (ray, back, front)) in group.iter().enumerate() {
-            queries[(i + k) % 4] = Some(Query { bvh, ray, back: *back, front: *front });
-        }
-        if k % 2 == 0 {
-            let (ray, back, front) = &group[0];
-            queries[(group.len() + k) % 4] = Some(Query { bvh: &empty, ray, back: *back, front: *front });
-        }
-        let got = nearest_each(queries, &mut stacks);
-        for (q, h) in queries.iter().zip(got) {
-            let alone = q.and_then(|q| nearest(q.bvh, q.ray, q.back, q.front, &mut Stack::default()));
-            prop_assert_eq!(hit_bits(h), hit_bits(alone), "query {} of group {}", k, group.len());
-        }
-    }
-    Ok(())
 }
 
 proptest! {

@@ -141,119 +141,50 @@ pub struct Stack(Vec<Todo>);
 /// [`BOX_MARGIN`]), and an axis the ray has no part of is tested by where the origin lies, not
 /// by `0 * inf`, which is NaN for a ray lying in a box's face.
 pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -> Option<Hit> {
-    Walk::new(Query { bvh, ray, back, front }, stack)?.run()
-}
-
-/// [`nearest`] for up to `N` rays (`None` for none), each in its own tree and range, their
-/// walks taken a visit at a time in turn: each ray gets the hit [`nearest`] gives it. A walk is
-/// a chain of dependent steps (a node's boxes say which node comes next) that leaves most of a
-/// core idle; independent chains side by side fill it (`docs/transfer.md`, "Rays").
-pub fn nearest_each<const N: usize>(queries: [Option<Query>; N], stacks: &mut [Stack; N]) -> [Option<Hit>; N] {
-    let mut stacks = stacks.each_mut().into_iter();
-    let mut walks = queries.map(|q| {
-        let stack = stacks.next().expect("a stack for each query");
-        Walk::new(q?, stack)
-    });
-    if walks.iter().flatten().any(Walk::flat) {
-        interleave::<true, N>(&mut walks);
+    if bvh.is_empty() {
+        return None;
+    }
+    let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
+    let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
+    // A component so small that its reciprocal overflows counts as none: the ray then stays in
+    // the slab it starts in (or out of it) however far it goes.
+    let flat = ray.inv.to_array().map(|x| x.is_infinite());
+    let boxes = Boxes { o, inv, flat };
+    // Nearly every ray has a part of every axis: their walk leaves out the test for one that
+    // has none.
+    if flat.contains(&true) {
+        walk::<true>(bvh, ray, &boxes, (-back, front), &mut stack.0)
     } else {
-        interleave::<false, N>(&mut walks);
+        walk::<false>(bvh, ray, &boxes, (-back, front), &mut stack.0)
     }
-    walks.map(|w| w?.best)
 }
 
-/// Steps each walk in turn until all are done.
-fn interleave<const FLAT: bool, const N: usize>(walks: &mut [Option<Walk>; N]) {
-    let mut going: u32 = walks.iter().enumerate().fold(0, |m, (i, w)| m | (w.is_some() as u32) << i);
-    while going != 0 {
-        for (i, w) in walks.iter_mut().enumerate() {
-            if going >> i & 1 == 1 && !w.as_mut().is_some_and(|w| w.step::<FLAT>()) {
-                going &= !(1 << i);
+/// [`nearest`]'s walk, from the root, over `(lo, hi)`; `FLAT` when the ray has no part of some
+/// axis.
+#[inline(always)]
+fn walk<const FLAT: bool>(
+    bvh: &Bvh,
+    ray: &Ray,
+    boxes: &Boxes,
+    (mut lo, mut hi): (f32, f32),
+    stack: &mut Vec<Todo>,
+) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    stack.clear();
+    let mut todo = Todo { child: 0, count: 0, gap: 0.0 };
+    loop {
+        if let Some(next) = visit::<FLAT>(bvh, ray, todo, boxes, &mut lo, &mut hi, &mut best, stack) {
+            todo = next;
+            continue;
+        }
+        // The next node or leaf that can still hold a hit as near as the best.
+        loop {
+            let Some(t) = stack.pop() else { return best };
+            if t.gap <= hi.max(-lo) {
+                todo = t;
+                break;
             }
         }
-    }
-}
-
-/// A ray's search: the tree, the ray, and how far back and in front of its origin it reaches
-/// (`t` in `[-back, front]`).
-#[derive(Clone, Copy)]
-pub struct Query<'a> {
-    pub bvh: &'a Bvh,
-    pub ray: &'a Ray,
-    pub back: f32,
-    pub front: f32,
-}
-
-/// One ray's walk through the tree: what is kept from one visit to the next.
-struct Walk<'a> {
-    bvh: &'a Bvh,
-    ray: &'a Ray,
-    boxes: Boxes,
-    lo: f32,
-    hi: f32,
-    best: Option<Hit>,
-    todo: Todo,
-    stack: &'a mut Vec<Todo>,
-}
-
-impl<'a> Walk<'a> {
-    /// The walk from the root, or none in an empty tree.
-    fn new(q: Query<'a>, stack: &'a mut Stack) -> Option<Walk<'a>> {
-        if q.bvh.is_empty() {
-            return None;
-        }
-        let ray = q.ray;
-        let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
-        let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
-        // A component so small that its reciprocal overflows counts as none: the ray then stays
-        // in the slab it starts in (or out of it) however far it goes.
-        let flat = ray.inv.to_array().map(|x| x.is_infinite());
-        stack.0.clear();
-        Some(Walk {
-            bvh: q.bvh,
-            ray,
-            boxes: Boxes { o, inv, flat },
-            lo: -q.back,
-            hi: q.front,
-            best: None,
-            todo: Todo { child: 0, count: 0, gap: 0.0 },
-            stack: &mut stack.0,
-        })
-    }
-
-    /// Whether the ray has no part of some axis.
-    fn flat(&self) -> bool {
-        self.boxes.flat.contains(&true)
-    }
-
-    /// The whole walk; the nearest hit.
-    fn run(mut self) -> Option<Hit> {
-        // Nearly every ray has a part of every axis: their walk leaves out the test for one
-        // that has none.
-        if self.flat() {
-            while self.step::<true>() {}
-        } else {
-            while self.step::<false>() {}
-        }
-        self.best
-    }
-
-    /// Visits the current node or leaf and picks the next; false once none is left that can
-    /// hold a hit as near as the best. `FLAT` when the ray may have no part of some axis.
-    #[inline(always)]
-    fn step<const FLAT: bool>(&mut self) -> bool {
-        let Walk { bvh, ray, boxes, lo, hi, best, todo, stack } = self;
-        if let Some(next) = visit::<FLAT>(bvh, ray, *todo, boxes, lo, hi, best, stack) {
-            *todo = next;
-            return true;
-        }
-        while let Some(t) = stack.pop() {
-            if t.gap <= hi.max(-*lo) {
-                *todo = t;
-                return true;
-            }
-        }
-        false
     }
 }
 

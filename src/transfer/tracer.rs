@@ -10,10 +10,6 @@ use rayon::prelude::*;
 
 /// Texel rows rasterised together.
 const BAND: usize = 8;
-/// Rays whose walks a core takes side by side ([`raycast::nearest_each`]): the ray stage took
-/// 25% less time with 4 than with 1, at 600k and at 10.24M triangles; 6 and 8 gave no more
-/// (`docs/transfer.md`, "Rays").
-const SIDE_BY_SIDE: usize = 4;
 
 /// How far a texel's samples found LOW; ordered, so that a texel keeps the best any sample gave.
 #[derive(Clone, Copy, Default, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -60,33 +56,6 @@ pub(super) struct Tracer<'a> {
 struct Sample {
     ts: Vec3A,
     t: Option<f32>,
-}
-
-impl Sample {
-    /// No hit: the surface's own normal, no distance.
-    const FLAT: Sample = Sample { ts: Vec3A::Z, t: None };
-}
-
-/// A sample's ray into its part's tree, and LOW's frame there for what the ray finds.
-struct Aim<'a> {
-    tree: &'a bvh::Bvh,
-    ray: raycast::Ray,
-    back: f32,
-    front: f32,
-    nrm: Vec3A,
-    tan: Vec3A,
-    sign: f32,
-}
-
-/// A sample's place and LOW triangle, and its ray or what it gave without one.
-type Aimed<'a> = (usize, u32, Result<Aim<'a>, Sample>);
-/// A sample's place and LOW triangle, and what it gave.
-type Done = (usize, u32, Sample);
-
-impl Aim<'_> {
-    fn query(&self) -> raycast::Query<'_> {
-        raycast::Query { bvh: self.tree, ray: &self.ray, back: self.back, front: self.front }
-    }
 }
 
 impl Tracer<'_> {
@@ -155,7 +124,7 @@ impl Tracer<'_> {
         let samples = raster::band(edges, cand, y0, y1, w, n);
         c.overlapping_samples = samples.overlapping;
         let sw = w * n;
-        let mut stacks: [raycast::Stack; SIDE_BY_SIDE] = std::array::from_fn(|_| raycast::Stack::default());
+        let mut stack = raycast::Stack::default();
         // Square tiles of BAND x BAND texels, one after another: neighbouring rays meet the same
         // part of HIGH's tree while it is still in cache. Each texel's samples keep their order
         // (rows, then columns), so the sums are the same as row by row.
@@ -163,8 +132,16 @@ impl Tracer<'_> {
             let (a, b) = (tx * BAND * n, ((tx + 1) * BAND).min(w) * n);
             (0..samples.owner.len() / sw).flat_map(move |sy| (a..b).map(move |sx| sy * sw + sx))
         });
-        let mut add = |(s, t, r): Done| {
-            let texel = (s / sw / n) * w + (s % sw) / n;
+        for s in order {
+            let t = samples.owner[s];
+            if t == u32::MAX {
+                continue;
+            }
+            let (sx, sy) = (s % sw, s / sw);
+            let (x, y) = raster::sample_pos(sx, sy, y0, n);
+            let texel = (sy / n) * w + sx / n;
+            let e = edges[t as usize].as_ref().expect("owners have edges");
+            let r = self.sample(t as usize, e.bary(x, y), &mut c, &mut stack);
             let part = self.low.tri_part[t as usize];
             let ps = &mut parts[part as usize];
             ps.rays += 1;
@@ -187,23 +164,7 @@ impl Tracer<'_> {
                     ps.missed_rays += 1;
                 }
             }
-        };
-        // Rays are traced [`SIDE_BY_SIDE`] at a time; their samples are added in the order above
-        // all the same.
-        let mut batch: Vec<Aimed> = Vec::with_capacity(SIDE_BY_SIDE);
-        for s in order {
-            let t = samples.owner[s];
-            if t == u32::MAX {
-                continue;
-            }
-            let (x, y) = raster::sample_pos(s % sw, s / sw, y0, n);
-            let e = edges[t as usize].as_ref().expect("owners have edges");
-            batch.push((s, t, self.aim(t as usize, e.bary(x, y), &mut c)));
-            if batch.len() == SIDE_BY_SIDE {
-                self.trace_batch(&mut batch, &mut c, &mut stacks, &mut add);
-            }
         }
-        self.trace_batch(&mut batch, &mut c, &mut stacks, &mut add);
         // The band's texels are counted here, on the core that traced them.
         for o in out.iter_mut() {
             match o.coverage {
@@ -226,8 +187,8 @@ impl Tracer<'_> {
         (c, parts)
     }
 
-    /// The ray from LOW triangle `t` at barycentrics `b`, or what the sample gives without one.
-    fn aim(&self, t: usize, b: [f32; 3], c: &mut Counts) -> Result<Aim<'_>, Sample> {
+    /// One ray from LOW triangle `t` at barycentrics `b`.
+    fn sample(&self, t: usize, b: [f32; 3], c: &mut Counts, stack: &mut raycast::Stack) -> Sample {
         let low = self.low;
         let tri = low.triangles[t];
         let mix = |f: &dyn Fn(usize) -> Vec3A| {
@@ -241,10 +202,11 @@ impl Tracer<'_> {
             + low.tangents[tri[2] as usize][3] * b[2];
         let sign = if w < 0.0 { -1.0 } else { 1.0 };
         c.rays += 1;
+        let flat = Sample { ts: Vec3A::Z, t: None };
         let Some(nhat) = nrm.try_normalize() else {
             c.degenerate_frames += 1;
             c.missed_rays += 1;
-            return Err(Sample::FLAT);
+            return flat;
         };
         let (dir, front, back) = match &low.cage {
             Some(cage) => {
@@ -260,41 +222,15 @@ impl Tracer<'_> {
             None => (nhat, self.front as f32, self.back as f32),
         };
         let set = self.low_set[low.tri_part[t] as usize];
+        let tree = &self.trees[set];
         let mut ray = raycast::Ray::new(p, dir);
         if self.front_faces_only {
             ray = ray.front_faces_only();
         }
-        Ok(Aim { tree: &self.trees[set], ray, back, front, nrm, tan, sign })
-    }
-
-    /// The rays of the samples in `batch` (at most [`SIDE_BY_SIDE`]), traced side by side
-    /// ([`raycast::nearest_each`]); adds their samples in order and empties it.
-    fn trace_batch(
-        &self,
-        batch: &mut Vec<Aimed>,
-        c: &mut Counts,
-        stacks: &mut [raycast::Stack; SIDE_BY_SIDE],
-        add: &mut impl FnMut(Done),
-    ) {
-        let queries: [Option<raycast::Query>; SIDE_BY_SIDE] =
-            std::array::from_fn(|i| batch.get(i)?.2.as_ref().ok().map(Aim::query));
-        let hits = raycast::nearest_each(queries, stacks);
-        for ((s, t, aim), hit) in batch.drain(..).zip(hits) {
-            let r = match aim {
-                Ok(a) => self.finish(&a, hit, c),
-                Err(r) => r,
-            };
-            add((s, t, r));
-        }
-    }
-
-    /// What the ray `a` gave, its hit being `hit`.
-    fn finish(&self, a: &Aim, hit: Option<raycast::Hit>, c: &mut Counts) -> Sample {
-        let Some(hit) = hit else {
+        let Some(hit) = raycast::nearest(tree, &ray, back, front, stack) else {
             c.missed_rays += 1;
-            return Sample::FLAT;
+            return flat;
         };
-        let Aim { tree, nrm, tan, sign, .. } = *a;
         let ni = tree.index(hit.slot as usize);
         let n = |k: usize| Vec3A::from(self.normals[ni[k] as usize]) * hit.bary[k];
         let hn = (n(0) + n(1) + n(2)).normalize_or_zero();
