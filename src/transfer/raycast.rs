@@ -5,8 +5,8 @@
 //! and rays through mesh vertices do not slip through HIGH. Edge values that come out exactly
 //! zero in f32 are recomputed in f64, as the paper advises. Degenerate triangles never hit.
 
-use super::bvh::Bvh;
-use glam::{Vec3A, Vec4};
+use super::bvh::{Bvh, WideNode};
+use glam::{BVec4A, Vec3A, Vec4};
 
 /// A ray prepared for the watertight test (its shear is computed once).
 #[derive(Debug, Clone, Copy)]
@@ -48,6 +48,17 @@ impl Ray {
     /// of the origin the hit lies on.
     pub fn front_faces_only(self) -> Ray {
         Ray { front_only: true, ..self }
+    }
+
+    /// The reciprocal of `dir`, for the box tests.
+    pub(super) fn inv(&self) -> Vec3A {
+        self.inv
+    }
+
+    /// Whether the ray has a part of every axis (nearly every ray has): one with none of some
+    /// axis needs the box test's case for it.
+    pub(super) fn has_every_axis(&self) -> bool {
+        self.inv.is_finite()
     }
 }
 
@@ -144,15 +155,10 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -
     if bvh.is_empty() {
         return None;
     }
-    let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
-    let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
-    // A component so small that its reciprocal overflows counts as none: the ray then stays in
-    // the slab it starts in (or out of it) however far it goes.
-    let flat = ray.inv.to_array().map(|x| x.is_infinite());
-    let boxes = Boxes { o, inv, flat };
+    let boxes = Boxes::of(ray);
     // Nearly every ray has a part of every axis: their walk leaves out the test for one that
     // has none.
-    if flat.contains(&true) {
+    if boxes.any_flat() {
         walk::<true>(bvh, ray, &boxes, (-back, front), &mut stack.0)
     } else {
         walk::<false>(bvh, ray, &boxes, (-back, front), &mut stack.0)
@@ -204,44 +210,33 @@ const fn gamma(n: u32) -> f32 {
 
 /// What every box test of one ray shares: its origin and reciprocal direction, one lane per
 /// child, and which axes it has no part of.
-struct Boxes {
+pub(super) struct Boxes {
     o: [Vec4; 3],
     inv: [Vec4; 3],
     flat: [bool; 3],
 }
 
-/// Tests a leaf's triangles, or a four-wide node's boxes: the children hit are pushed, farthest
-/// first, except the nearest, which is returned to be visited next.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn visit<const FLAT: bool>(
-    bvh: &Bvh,
-    ray: &Ray,
-    todo: Todo,
-    boxes: &Boxes,
-    lo: &mut f32,
-    hi: &mut f32,
-    best: &mut Option<Hit>,
-    stack: &mut Vec<Todo>,
-) -> Option<Todo> {
-    if todo.count > 0 {
-        for k in todo.child as usize..(todo.child + todo.count) as usize {
-            let Some((t, bary)) = intersect(ray, bvh.corners(k)) else { continue };
-            if t < *lo || t > *hi {
-                continue;
-            }
-            let h = Hit { t, id: bvh.ids[k], slot: k as u32, bary };
-            if best.as_ref().is_none_or(|b| h.better_than(b)) {
-                *best = Some(h);
-                // Nothing farther than this hit can win; equal distances still can (lower
-                // index), so the range stays closed.
-                *lo = lo.max(-t.abs());
-                *hi = hi.min(t.abs());
-            }
-        }
-        return None;
+impl Boxes {
+    pub(super) fn of(ray: &Ray) -> Boxes {
+        let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
+        let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
+        // A component so small that its reciprocal overflows counts as none: the ray then stays
+        // in the slab it starts in (or out of it) however far it goes.
+        let flat = ray.inv.to_array().map(|x| x.is_infinite());
+        Boxes { o, inv, flat }
     }
-    let n = &bvh.nodes[todo.child as usize];
+
+    /// Whether the ray has no part of some axis (its walk must then test for it).
+    pub(super) fn any_flat(&self) -> bool {
+        self.flat.contains(&true)
+    }
+}
+
+/// Which of node `n`'s child boxes the ray's part `[lo, hi]` meets (lanes past `n.lanes` have no
+/// child), and how far each box's part of the ray lies from the origin; `FLAT` when the ray has
+/// no part of some axis.
+#[inline(always)]
+pub(super) fn hit_lanes<const FLAT: bool>(n: &WideNode, boxes: &Boxes, lo: f32, hi: f32) -> (BVec4A, Vec4) {
     let Boxes { o, inv, flat } = boxes;
     let slab = |a: usize| {
         if FLAT && flat[a] {
@@ -260,15 +255,65 @@ fn visit<const FLAT: bool>(
     // stays infinite instead of becoming `inf - inf`.
     let m = Vec4::splat(BOX_MARGIN);
     let (near, far) = (ax.max(ay).max(az), bx.min(by).min(bz));
-    let near = (near * (Vec4::ONE - m.copysign(near))).max(Vec4::splat(*lo));
-    let far = (far * (Vec4::ONE + m.copysign(far))).min(Vec4::splat(*hi));
-    let mut mask = near.cmple(far).bitmask() & n.lanes;
+    let near = (near * (Vec4::ONE - m.copysign(near))).max(Vec4::splat(lo));
+    let far = (far * (Vec4::ONE + m.copysign(far))).min(Vec4::splat(hi));
+    // The gap: `near` when the part is ahead, `-far` when behind, else 0 (branch-free: the
+    // lanes hit have `near <= far`).
+    (near.cmple(far), near.max(-far).max(Vec4::ZERO))
+}
+
+/// Tests leaf-order triangle `k` against the ray's part `[lo, hi]`, keeping the best hit and
+/// narrowing the part to what can still beat it.
+#[inline(always)]
+pub(super) fn test_leaf(
+    bvh: &Bvh,
+    ray: &Ray,
+    k: usize,
+    lo: &mut f32,
+    hi: &mut f32,
+    best: &mut Option<Hit>,
+) {
+    let Some((t, bary)) = intersect(ray, bvh.corners(k)) else { return };
+    if t < *lo || t > *hi {
+        return;
+    }
+    let h = Hit { t, id: bvh.ids[k], slot: k as u32, bary };
+    if best.as_ref().is_none_or(|b| h.better_than(b)) {
+        *best = Some(h);
+        // Nothing farther than this hit can win; equal distances still can (lower index), so
+        // the range stays closed.
+        *lo = lo.max(-t.abs());
+        *hi = hi.min(t.abs());
+    }
+}
+
+/// Tests a leaf's triangles, or a four-wide node's boxes: the children hit are pushed, farthest
+/// first, except the nearest, which is returned to be visited next.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn visit<const FLAT: bool>(
+    bvh: &Bvh,
+    ray: &Ray,
+    todo: Todo,
+    boxes: &Boxes,
+    lo: &mut f32,
+    hi: &mut f32,
+    best: &mut Option<Hit>,
+    stack: &mut Vec<Todo>,
+) -> Option<Todo> {
+    if todo.count > 0 {
+        for k in todo.child as usize..(todo.child + todo.count) as usize {
+            test_leaf(bvh, ray, k, lo, hi, best);
+        }
+        return None;
+    }
+    let n = &bvh.nodes[todo.child as usize];
+    let (hits, gaps) = hit_lanes::<FLAT>(n, boxes, *lo, *hi);
+    let mut mask = hits.bitmask() & n.lanes;
     if mask == 0 {
         return None;
     }
-    // How far each child's part of the ray lies from the origin: `near` when it is ahead,
-    // `-far` when behind, else 0 (branch-free: the lanes in `mask` have `near <= far`).
-    let gaps = near.max(-far).max(Vec4::ZERO).to_array();
+    let gaps = gaps.to_array();
     let kid = |lane: usize| Todo { child: n.child[lane], count: n.count[lane] as u32, gap: gaps[lane] };
     // The nearest child is visited next (ties: the lower lane); the others are pushed farthest
     // first, so they pop nearest first.

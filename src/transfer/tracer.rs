@@ -4,7 +4,7 @@
 use super::mesh::Low;
 use super::raster::{self, Edges, UvTri};
 use super::report::{Counts, PartStats};
-use super::{bvh, raycast, Settings};
+use super::{bvh, packet, raycast, Settings};
 use glam::{Mat3A, Vec3A};
 use rayon::prelude::*;
 
@@ -56,6 +56,29 @@ pub(super) struct Tracer<'a> {
 struct Sample {
     ts: Vec3A,
     t: Option<f32>,
+}
+
+impl Sample {
+    /// A sample without a hit, or without a frame to shade one in.
+    const FLAT: Sample = Sample { ts: Vec3A::Z, t: None };
+}
+
+/// A sample's ray, before it is traced, and the frame its hit is shaded in.
+struct Pending {
+    ray: raycast::Ray,
+    back: f32,
+    front: f32,
+    /// Which of HIGH's trees the ray goes into.
+    set: usize,
+    nrm: Vec3A,
+    tan: Vec3A,
+    sign: f32,
+}
+
+/// A sample as it waits for its packet.
+enum Prep {
+    Done(Sample),
+    Trace(Pending),
 }
 
 impl Tracer<'_> {
@@ -124,7 +147,7 @@ impl Tracer<'_> {
         let samples = raster::band(edges, cand, y0, y1, w, n);
         c.overlapping_samples = samples.overlapping;
         let sw = w * n;
-        let mut stack = raycast::Stack::default();
+        let mut stacks = (raycast::Stack::default(), packet::PacketStack::default());
         // Square tiles of BAND x BAND texels, one after another: neighbouring rays meet the same
         // part of HIGH's tree while it is still in cache. Each texel's samples keep their order
         // (rows, then columns), so the sums are the same as row by row.
@@ -132,6 +155,44 @@ impl Tracer<'_> {
             let (a, b) = (tx * BAND * n, ((tx + 1) * BAND).min(w) * n);
             (0..samples.owner.len() / sw).flat_map(move |sy| (a..b).map(move |sx| sy * sw + sx))
         });
+        // Samples wait here until a packet of rays into one tree is full, then are traced
+        // together and summed in their order.
+        let mut queue: Vec<(usize, Prep)> = Vec::with_capacity(2 * packet::PACKET);
+        let mut record = |queue: &mut Vec<(usize, Prep)>, c: &mut Counts, stacks: &mut (raycast::Stack, packet::PacketStack)| {
+            let hits = self.trace_queued(queue, stacks);
+            let mut hits = hits.iter();
+            for (s, prep) in queue.drain(..) {
+                let t = samples.owner[s];
+                let r = match prep {
+                    Prep::Done(r) => r,
+                    Prep::Trace(p) => self.finish(&p, *hits.next().expect("a hit a ray"), c),
+                };
+                let texel = (s / sw / n) * w + (s % sw) / n;
+                let part = self.low.tri_part[t as usize];
+                let ps = &mut parts[part as usize];
+                ps.rays += 1;
+                let o = &mut out[texel];
+                if o.samples == 0 {
+                    o.part = part;
+                }
+                o.coverage = o.coverage.max(if samples.inside(s) { Coverage::Covered } else { Coverage::Extended });
+                o.samples += 1;
+                // The samples' sum, normalised below.
+                o.normal = (Vec3A::from(o.normal) + r.ts).to_array();
+                match r.t {
+                    Some(d) => {
+                        o.height += d;
+                        o.hits += 1;
+                        ps.hit(d);
+                    }
+                    None => {
+                        o.missed += 1;
+                        ps.missed_rays += 1;
+                    }
+                }
+            }
+        };
+        let mut rays = 0;
         for s in order {
             let t = samples.owner[s];
             if t == u32::MAX {
@@ -139,32 +200,19 @@ impl Tracer<'_> {
             }
             let (sx, sy) = (s % sw, s / sw);
             let (x, y) = raster::sample_pos(sx, sy, y0, n);
-            let texel = (sy / n) * w + sx / n;
             let e = edges[t as usize].as_ref().expect("owners have edges");
-            let r = self.sample(t as usize, e.bary(x, y), &mut c, &mut stack);
-            let part = self.low.tri_part[t as usize];
-            let ps = &mut parts[part as usize];
-            ps.rays += 1;
-            let o = &mut out[texel];
-            if o.samples == 0 {
-                o.part = part;
-            }
-            o.coverage = o.coverage.max(if samples.inside(s) { Coverage::Covered } else { Coverage::Extended });
-            o.samples += 1;
-            // The samples' sum, normalised below.
-            o.normal = (Vec3A::from(o.normal) + r.ts).to_array();
-            match r.t {
-                Some(d) => {
-                    o.height += d;
-                    o.hits += 1;
-                    ps.hit(d);
+            let prep = self.prepare(t as usize, e.bary(x, y), &mut c);
+            if let Prep::Trace(p) = &prep {
+                let other_tree = queue.iter().any(|(_, q)| matches!(q, Prep::Trace(q) if q.set != p.set));
+                if rays == packet::PACKET || other_tree {
+                    record(&mut queue, &mut c, &mut stacks);
+                    rays = 0;
                 }
-                None => {
-                    o.missed += 1;
-                    ps.missed_rays += 1;
-                }
+                rays += 1;
             }
+            queue.push((s, prep));
         }
+        record(&mut queue, &mut c, &mut stacks);
         // The band's texels are counted here, on the core that traced them.
         for o in out.iter_mut() {
             match o.coverage {
@@ -187,8 +235,28 @@ impl Tracer<'_> {
         (c, parts)
     }
 
-    /// One ray from LOW triangle `t` at barycentrics `b`.
-    fn sample(&self, t: usize, b: [f32; 3], c: &mut Counts, stack: &mut raycast::Stack) -> Sample {
+    /// The hits of the queued samples' rays, in their order (all into one tree).
+    fn trace_queued(
+        &self,
+        queue: &[(usize, Prep)],
+        (single, packets): &mut (raycast::Stack, packet::PacketStack),
+    ) -> Vec<Option<raycast::Hit>> {
+        let pending: Vec<&Pending> =
+            queue.iter().filter_map(|(_, p)| if let Prep::Trace(p) = p { Some(p) } else { None }).collect();
+        let Some(first) = pending.first() else { return Vec::new() };
+        let tree = &self.trees[first.set];
+        if !PACKETS.load(std::sync::atomic::Ordering::Relaxed) {
+            return pending.iter().map(|p| raycast::nearest(tree, &p.ray, p.back, p.front, single)).collect();
+        }
+        let rays: Vec<(raycast::Ray, f32, f32)> = pending.iter().map(|p| (p.ray, p.back, p.front)).collect();
+        let mut out = vec![None; rays.len()];
+        packet::nearest_packet(tree, &rays, &mut out, packets);
+        out
+    }
+
+    /// One sample from LOW triangle `t` at barycentrics `b`: its ray, or what it gives if it
+    /// has none.
+    fn prepare(&self, t: usize, b: [f32; 3], c: &mut Counts) -> Prep {
         let low = self.low;
         let tri = low.triangles[t];
         let mix = |f: &dyn Fn(usize) -> Vec3A| {
@@ -202,11 +270,10 @@ impl Tracer<'_> {
             + low.tangents[tri[2] as usize][3] * b[2];
         let sign = if w < 0.0 { -1.0 } else { 1.0 };
         c.rays += 1;
-        let flat = Sample { ts: Vec3A::Z, t: None };
         let Some(nhat) = nrm.try_normalize() else {
             c.degenerate_frames += 1;
             c.missed_rays += 1;
-            return flat;
+            return Prep::Done(Sample::FLAT);
         };
         let (dir, front, back) = match &low.cage {
             Some(cage) => {
@@ -222,19 +289,25 @@ impl Tracer<'_> {
             None => (nhat, self.front as f32, self.back as f32),
         };
         let set = self.low_set[low.tri_part[t] as usize];
-        let tree = &self.trees[set];
         let mut ray = raycast::Ray::new(p, dir);
         if self.front_faces_only {
             ray = ray.front_faces_only();
         }
-        let Some(hit) = raycast::nearest(tree, &ray, back, front, stack) else {
+        Prep::Trace(Pending { ray, back, front, set, nrm, tan, sign })
+    }
+
+    /// What sample `p`'s ray gave, in LOW's tangent space.
+    fn finish(&self, p: &Pending, hit: Option<raycast::Hit>, c: &mut Counts) -> Sample {
+        let Some(hit) = hit else {
             c.missed_rays += 1;
-            return flat;
+            return Sample::FLAT;
         };
+        let tree = &self.trees[p.set];
         let ni = tree.index(hit.slot as usize);
         let n = |k: usize| Vec3A::from(self.normals[ni[k] as usize]) * hit.bary[k];
         let hn = (n(0) + n(1) + n(2)).normalize_or_zero();
-        let bit = nrm.cross(tan) * sign;
+        let (tan, nrm) = (p.tan, p.nrm);
+        let bit = nrm.cross(tan) * p.sign;
         let m = Mat3A::from_cols(tan, bit, nrm);
         let det = m.determinant();
         let scale = tan.length() * bit.length() * nrm.length();
@@ -251,3 +324,5 @@ impl Tracer<'_> {
         Sample { ts, t: Some(hit.t) }
     }
 }
+
+pub static PACKETS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
