@@ -7,6 +7,9 @@
 //! duplicated triangles, flat boxes), repeated corners and collinear corners (zero area), and
 //! rays aimed at vertices and edges, along axes (slab bounds of `0 * inf`) and within planes.
 //!
+//! Every check also walks the rays in packets (`packet::nearest_packet`), of neighbouring
+//! rays as a bake sends them and of unrelated ones, and holds each ray's hit to the scan's.
+//!
 //! Hard-surface soups join them: axis-aligned boxes, bevelled cubes and grids on integer
 //! coordinates, where edges and whole faces lie in the planes of the tree's boxes, with rays
 //! from grid points aimed at their vertices and edges and along their faces. There, a box test
@@ -14,6 +17,7 @@
 //! for a ray lying in a box's face loses the box (the last two tests hold one case of each).
 
 use bumpbake::transfer::bvh::Bvh;
+use bumpbake::transfer::packet::{nearest_packet, PacketStack, PACKET};
 use bumpbake::transfer::raycast::{intersect, nearest, Hit, Ray, Stack};
 use glam::Vec3A;
 use proptest::prelude::*;
@@ -283,10 +287,12 @@ fn make_ray(pts: &[[f32; 3]], tris: &[[u32; 3]], (origin, aim, _, _): &RaySpec) 
     (dir != Vec3A::ZERO && dir.is_finite()).then(|| Ray::new(o, dir))
 }
 
-/// How many rays hit; the tree's answer must be the scan's, bit for bit, on every ray.
+/// How many rays hit; the tree's answer must be the scan's, bit for bit, on every ray, walked
+/// alone and in packets.
 fn check(pts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[RaySpec]) -> Result<usize, TestCaseError> {
     let bvh = Bvh::build_indexed(pts, tris.to_vec(), shading_index);
     let mut hits = 0;
+    let mut wanted = Vec::new();
     for spec in rays {
         let Some(ray) = make_ray(pts, tris, spec) else { continue };
         let (back, front) = (spec.2, spec.3);
@@ -302,8 +308,38 @@ fn check(pts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[RaySpec]) -> Result<usize,
             got,
             want
         );
+        wanted.push(((ray, back, front), want));
     }
+    in_packets(&bvh, &wanted)?;
     Ok(hits)
+}
+
+/// Packets of the rays with a part of every axis (those a packet walks together; a packet with
+/// another walks each ray alone), then of all the rays in their order, of every size up to
+/// [`PACKET`]: each ray's hit must be the scan's `want`.
+fn in_packets(bvh: &Bvh, wanted: &[((Ray, f32, f32), Option<Found>)]) -> Result<(), TestCaseError> {
+    let every_axis = |r: &Ray| r.dir.to_array().iter().all(|&d| (1.0 / d).is_finite());
+    let free: Vec<_> = wanted.iter().filter(|(r, _)| every_axis(&r.0)).cloned().collect();
+    let mut stack = PacketStack::default();
+    for (group, size) in [(&free, PACKET), (&free, 3), (&wanted.to_vec(), PACKET), (&free, 1)] {
+        for chunk in group.chunks(size) {
+            let rays: Vec<(Ray, f32, f32)> = chunk.iter().map(|w| w.0).collect();
+            let mut out = vec![None; rays.len()];
+            nearest_packet(bvh, &rays, &mut out, &mut stack);
+            for (got, (ray, want)) in out.iter().zip(chunk) {
+                let got = got.map(|h| (h.id, h.t, h.bary));
+                prop_assert!(
+                    bits(got) == bits(*want),
+                    "ray {:?} in a packet of {}: tree {:?}, scan {:?}",
+                    ray,
+                    rays.len(),
+                    got,
+                    want
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 proptest! {
@@ -375,6 +411,37 @@ fn nearest_equals_a_scan_on_large_soups() {
         let hits = check(&pts, &tris, &rays).unwrap_or_else(|e| panic!("{n} triangles: {e}"));
         assert!(hits > 20, "{n} triangles: only {hits} rays hit");
     }
+}
+
+/// What a bake sends: packets of neighbouring, nearly parallel rays, from a plane above a
+/// terrace of integer heights (faces and edges in the planes of the tree's boxes), some of them
+/// aimed through its vertices and edges, both ways along the line. Every ray alone and in
+/// packets gets the scan's hit.
+#[test]
+fn neighbouring_rays_in_packets_equal_a_scan() {
+    let side = 48u32;
+    let height = |i: u32, j: u32| ((i / 6 + j / 9) % 4) as f32;
+    let pts: Vec<[f32; 3]> =
+        (0..=side).flat_map(|j| (0..=side).map(move |i| [i as f32, j as f32, height(i, j)])).collect();
+    let at = |i: u32, j: u32| j * (side + 1) + i;
+    let tris: Vec<[u32; 3]> = (0..side)
+        .flat_map(|j| (0..side).flat_map(move |i| [[at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]]))
+        .collect();
+    let mut rays: Vec<RaySpec> = Vec::new();
+    // Tiles of 4 x 4 origins a quarter apart, each tile's rays along one direction; every
+    // other tile's origins on the vertex grid, so that its rays pass through vertices and edges.
+    for (k, (ti, tj)) in [(3.0f32, 5.0f32), (17.0, 30.0), (40.0, 11.0), (25.0, 44.0)].into_iter().enumerate() {
+        let offset = if k % 2 == 0 { 0.0 } else { 0.125 };
+        let dir = [[0.01, -0.02, -1.0], [0.0, 0.0, -1.0], [0.3, 0.2, -1.0], [-0.25, 0.01, 1.0]][k];
+        for b in 0..4 {
+            for a in 0..4 {
+                let o = [ti + a as f32 * 0.25 + offset, tj + b as f32 * 0.25 + offset, if dir[2] < 0.0 { 6.0 } else { -2.0 }];
+                rays.push((o, Aim::Any(dir), 9.0, 9.0));
+            }
+        }
+    }
+    let hits = check(&pts, &tris, &rays).expect("every ray as the scan");
+    assert!(hits > 50, "only {hits} rays hit");
 }
 
 /// One triangle, one ray, as the scan sees it and as the tree does.

@@ -208,19 +208,6 @@ pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<Hig
             back,
             front_faces_only: s.ignore_backfaces,
         };
-        if let Some(v) = std::env::var_os("BB_PACKETS") {
-            tracer::PACKETS.store(v == "1", std::sync::atomic::Ordering::Relaxed);
-        }
-        if std::env::var_os("BB_AB").is_some() {
-            for k in 0..8 {
-                let on = k % 2 == 0;
-                tracer::PACKETS.store(on, std::sync::atomic::Ordering::Relaxed);
-                let t0 = std::time::Instant::now();
-                let r = tracer.trace(s);
-                eprintln!("AB packets={on} {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
-                drop(r);
-            }
-        }
         let (texels, mut c, mut part_stats) = t.time("rays", || tracer.trace(s));
         crate::timings::mem_mark("transfer rays");
         let (w, h) = (s.width, s.height);

@@ -16,7 +16,10 @@ use super::bvh::Bvh;
 use super::raycast::{self, Hit, Ray};
 
 /// The most rays walked together.
-pub const PACKET: usize = 8;
+pub const PACKET: usize = 16;
+
+/// Eight-wide vectors a packet's rays fill.
+const HALVES: usize = PACKET / 8;
 
 /// A node or a leaf still to visit, the rays that still meet it, and how far its part of each of
 /// them lies from its origin.
@@ -60,7 +63,7 @@ fn avx() -> bool {
 
 #[cfg(target_arch = "x86_64")]
 mod wide {
-    use super::{Entry, PACKET};
+    use super::{Entry, HALVES, PACKET};
     use crate::transfer::bvh::{Bvh, WideNode};
     use crate::transfer::raycast::{test_leaf, Hit, Ray, BOX_MARGIN};
     use std::arch::x86_64::*;
@@ -68,8 +71,8 @@ mod wide {
     /// The rays' origins and reciprocal directions by axis, a ray a lane.
     struct Rays<'a> {
         rays: &'a [(Ray, f32, f32)],
-        o: [__m256; 3],
-        inv: [__m256; 3],
+        o: [[__m256; 3]; HALVES],
+        inv: [[__m256; 3]; HALVES],
         /// Each ray's part of the line still to search; `hi[i] = lo[i] = 0` past the last ray.
         lo: [f32; PACKET],
         hi: [f32; PACKET],
@@ -78,23 +81,23 @@ mod wide {
     /// The walk of [`super::nearest_packet`]. Its rays all have a part of every axis.
     #[target_feature(enable = "avx")]
     pub(super) fn walk(bvh: &Bvh, rays: &[(Ray, f32, f32)], out: &mut [Option<Hit>], stack: &mut Vec<Entry>) {
-        let lane = |f: &dyn Fn(&Ray) -> f32| {
-            let mut v = [0.0f32; PACKET];
-            for (x, r) in v.iter_mut().zip(rays) {
+        let lane = |h: usize, f: &dyn Fn(&Ray) -> f32| {
+            let mut v = [0.0f32; 8];
+            for (x, r) in v.iter_mut().zip(rays.iter().skip(8 * h)) {
                 *x = f(&r.0);
             }
             // SAFETY: `v` holds eight floats.
             unsafe { _mm256_loadu_ps(v.as_ptr()) }
         };
-        let o = [lane(&|r| r.origin.x), lane(&|r| r.origin.y), lane(&|r| r.origin.z)];
-        let inv = [lane(&|r| r.inv().x), lane(&|r| r.inv().y), lane(&|r| r.inv().z)];
+        let o = std::array::from_fn(|h| [lane(h, &|r| r.origin.x), lane(h, &|r| r.origin.y), lane(h, &|r| r.origin.z)]);
+        let inv = std::array::from_fn(|h| [lane(h, &|r| r.inv().x), lane(h, &|r| r.inv().y), lane(h, &|r| r.inv().z)]);
         let mut p = Rays { rays, o, inv, lo: [0.0; PACKET], hi: [0.0; PACKET] };
         for (i, &(_, back, front)) in rays.iter().enumerate() {
             (p.lo[i], p.hi[i]) = (-back, front);
         }
         out.iter_mut().for_each(|o| *o = None);
         stack.clear();
-        let mut todo = Entry { gaps: [0.0; PACKET], child: 0, count: 0, rays: (1u32 << rays.len()) - 1 };
+        let mut todo = Entry { gaps: [0.0; PACKET], child: 0, count: 0, rays: u32::MAX >> (32 - rays.len()) };
         loop {
             if todo.count > 0 {
                 for k in todo.child as usize..(todo.child + todo.count) as usize {
@@ -112,11 +115,18 @@ mod wide {
             // The next node or leaf that some ray can still find a hit in as near as its best.
             loop {
                 let Some(mut t) = stack.pop() else { return };
-                // SAFETY: eight floats each.
-                let (gaps, lo, hi) =
-                    unsafe { (_mm256_loadu_ps(t.gaps.as_ptr()), _mm256_loadu_ps(p.lo.as_ptr()), _mm256_loadu_ps(p.hi.as_ptr())) };
-                let reach = _mm256_max_ps(hi, neg(lo));
-                t.rays &= !(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(gaps, reach)) as u32);
+                for h in 0..HALVES {
+                    // SAFETY: eight floats each from `8 * h`.
+                    let (gaps, lo, hi) = unsafe {
+                        (
+                            _mm256_loadu_ps(t.gaps.as_ptr().add(8 * h)),
+                            _mm256_loadu_ps(p.lo.as_ptr().add(8 * h)),
+                            _mm256_loadu_ps(p.hi.as_ptr().add(8 * h)),
+                        )
+                    };
+                    let reach = _mm256_max_ps(hi, neg(lo));
+                    t.rays &= !((_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(gaps, reach)) as u32) << (8 * h));
+                }
                 if t.rays != 0 {
                     todo = t;
                     break;
@@ -146,8 +156,6 @@ mod wide {
     #[inline]
     #[target_feature(enable = "avx")]
     fn node(p: &Rays, n: &WideNode, rays: u32, stack: &mut Vec<Entry>) -> Option<Entry> {
-        // SAFETY: eight floats each.
-        let (lo, hi) = unsafe { (_mm256_loadu_ps(p.lo.as_ptr()), _mm256_loadu_ps(p.hi.as_ptr())) };
         let m = _mm256_set1_ps(BOX_MARGIN);
         let one = _mm256_set1_ps(1.0);
         let mut kids = [Entry { gaps: [0.0; PACKET], child: 0, count: 0, rays: 0 }; 4];
@@ -157,28 +165,39 @@ mod wide {
             if n.lanes & 1 << lane == 0 {
                 continue;
             }
-            let slab = |a: usize| {
-                let t0 = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(n.min[a][lane]), p.o[a]), p.inv[a]);
-                let t1 = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(n.max[a][lane]), p.o[a]), p.inv[a]);
-                (_mm256_min_ps(t0, t1), _mm256_max_ps(t0, t1))
-            };
-            let ((ax, bx), (ay, by), (az, bz)) = (slab(0), slab(1), slab(2));
-            let near = _mm256_max_ps(_mm256_max_ps(ax, ay), az);
-            let far = _mm256_min_ps(_mm256_min_ps(bx, by), bz);
-            let near = _mm256_max_ps(_mm256_mul_ps(near, _mm256_sub_ps(one, copysign(m, near))), lo);
-            let far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_add_ps(one, copysign(m, far))), hi);
-            let hit = _mm256_cmp_ps::<_CMP_LE_OS>(near, far);
-            let r = _mm256_movemask_ps(hit) as u32 & rays;
-            if r == 0 {
-                continue;
-            }
-            let gaps = _mm256_max_ps(_mm256_max_ps(near, neg(far)), _mm256_setzero_ps());
             let k = &mut kids[lane];
-            // SAFETY: eight floats.
-            unsafe { _mm256_storeu_ps(k.gaps.as_mut_ptr(), gaps) };
-            (k.child, k.count, k.rays) = (n.child[lane], n.count[lane] as u32, r);
-            least[lane] = hmin(_mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), gaps, hit));
-            mask |= 1 << lane;
+            for h in 0..HALVES {
+                if rays >> (8 * h) & 0xff == 0 {
+                    continue;
+                }
+                // SAFETY: eight floats each from `8 * h`.
+                let (lo, hi) = unsafe { (_mm256_loadu_ps(p.lo.as_ptr().add(8 * h)), _mm256_loadu_ps(p.hi.as_ptr().add(8 * h))) };
+                let (o, inv) = (&p.o[h], &p.inv[h]);
+                let slab = |a: usize| {
+                    let t0 = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(n.min[a][lane]), o[a]), inv[a]);
+                    let t1 = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(n.max[a][lane]), o[a]), inv[a]);
+                    (_mm256_min_ps(t0, t1), _mm256_max_ps(t0, t1))
+                };
+                let ((ax, bx), (ay, by), (az, bz)) = (slab(0), slab(1), slab(2));
+                let near = _mm256_max_ps(_mm256_max_ps(ax, ay), az);
+                let far = _mm256_min_ps(_mm256_min_ps(bx, by), bz);
+                let near = _mm256_max_ps(_mm256_mul_ps(near, _mm256_sub_ps(one, copysign(m, near))), lo);
+                let far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_add_ps(one, copysign(m, far))), hi);
+                let hit = _mm256_cmp_ps::<_CMP_LE_OS>(near, far);
+                let r = (_mm256_movemask_ps(hit) as u32) << (8 * h) & rays;
+                if r == 0 {
+                    continue;
+                }
+                let gaps = _mm256_max_ps(_mm256_max_ps(near, neg(far)), _mm256_setzero_ps());
+                // SAFETY: eight floats from `8 * h`.
+                unsafe { _mm256_storeu_ps(k.gaps.as_mut_ptr().add(8 * h), gaps) };
+                k.rays |= r;
+                least[lane] = least[lane].min(hmin(_mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), gaps, hit)));
+            }
+            if k.rays != 0 {
+                (k.child, k.count) = (n.child[lane], n.count[lane] as u32);
+                mask |= 1 << lane;
+            }
         }
         if mask == 0 {
             return None;

@@ -81,6 +81,46 @@ enum Prep {
     Trace(Pending),
 }
 
+/// Samples waiting for their packet ([`packet::nearest_packet`]): neighbouring samples' rays
+/// are traced together once [`packet::PACKET`] of them into one tree are queued.
+#[derive(Default)]
+struct Queue {
+    samples: Vec<(usize, Prep)>,
+    /// The queued samples' rays, with their reach behind and ahead.
+    rays: Vec<(raycast::Ray, f32, f32)>,
+    /// Which of HIGH's trees they go into.
+    set: usize,
+    /// After [`Queue::trace`], the rays' hits.
+    hits: Vec<Option<raycast::Hit>>,
+    stack: packet::PacketStack,
+}
+
+impl Queue {
+    /// Whether the queued rays must be traced before `prep` joins them: the packet is full, or
+    /// `prep`'s ray goes into another tree.
+    fn full_for(&self, prep: &Prep) -> bool {
+        let full = self.rays.len() == packet::PACKET;
+        matches!(prep, Prep::Trace(p) if full || (!self.rays.is_empty() && p.set != self.set))
+    }
+
+    fn push(&mut self, s: usize, prep: Prep) {
+        if let Prep::Trace(p) = &prep {
+            self.rays.push((p.ray, p.back, p.front));
+            self.set = p.set;
+        }
+        self.samples.push((s, prep));
+    }
+
+    /// Traces the queued rays into `hits`.
+    fn trace(&mut self, trees: &[bvh::Bvh]) {
+        self.hits.clear();
+        self.hits.resize(self.rays.len(), None);
+        if !self.rays.is_empty() {
+            packet::nearest_packet(&trees[self.set], &self.rays, &mut self.hits, &mut self.stack);
+        }
+    }
+}
+
 impl Tracer<'_> {
     /// Every texel of the map: its samples' rays, summed.
     pub(super) fn trace(&self, s: &Settings) -> (Vec<Texel>, Counts, Vec<PartStats>) {
@@ -147,7 +187,6 @@ impl Tracer<'_> {
         let samples = raster::band(edges, cand, y0, y1, w, n);
         c.overlapping_samples = samples.overlapping;
         let sw = w * n;
-        let mut stacks = (raycast::Stack::default(), packet::PacketStack::default());
         // Square tiles of BAND x BAND texels, one after another: neighbouring rays meet the same
         // part of HIGH's tree while it is still in cache. Each texel's samples keep their order
         // (rows, then columns), so the sums are the same as row by row.
@@ -155,13 +194,13 @@ impl Tracer<'_> {
             let (a, b) = (tx * BAND * n, ((tx + 1) * BAND).min(w) * n);
             (0..samples.owner.len() / sw).flat_map(move |sy| (a..b).map(move |sx| sy * sw + sx))
         });
-        // Samples wait here until a packet of rays into one tree is full, then are traced
-        // together and summed in their order.
-        let mut queue: Vec<(usize, Prep)> = Vec::with_capacity(2 * packet::PACKET);
-        let mut record = |queue: &mut Vec<(usize, Prep)>, c: &mut Counts, stacks: &mut (raycast::Stack, packet::PacketStack)| {
-            let hits = self.trace_queued(queue, stacks);
-            let mut hits = hits.iter();
-            for (s, prep) in queue.drain(..) {
+        let mut queue = Queue::default();
+        // Traces the queued samples' rays and sums what each sample gave into its texel, in the
+        // samples' order.
+        let mut record = |queue: &mut Queue, c: &mut Counts| {
+            queue.trace(self.trees);
+            let mut hits = queue.hits.iter();
+            for (s, prep) in queue.samples.drain(..) {
                 let t = samples.owner[s];
                 let r = match prep {
                     Prep::Done(r) => r,
@@ -191,8 +230,8 @@ impl Tracer<'_> {
                     }
                 }
             }
+            queue.rays.clear();
         };
-        let mut rays = 0;
         for s in order {
             let t = samples.owner[s];
             if t == u32::MAX {
@@ -202,17 +241,12 @@ impl Tracer<'_> {
             let (x, y) = raster::sample_pos(sx, sy, y0, n);
             let e = edges[t as usize].as_ref().expect("owners have edges");
             let prep = self.prepare(t as usize, e.bary(x, y), &mut c);
-            if let Prep::Trace(p) = &prep {
-                let other_tree = queue.iter().any(|(_, q)| matches!(q, Prep::Trace(q) if q.set != p.set));
-                if rays == packet::PACKET || other_tree {
-                    record(&mut queue, &mut c, &mut stacks);
-                    rays = 0;
-                }
-                rays += 1;
+            if queue.full_for(&prep) {
+                record(&mut queue, &mut c);
             }
-            queue.push((s, prep));
+            queue.push(s, prep);
         }
-        record(&mut queue, &mut c, &mut stacks);
+        record(&mut queue, &mut c);
         // The band's texels are counted here, on the core that traced them.
         for o in out.iter_mut() {
             match o.coverage {
@@ -233,25 +267,6 @@ impl Tracer<'_> {
             }
         }
         (c, parts)
-    }
-
-    /// The hits of the queued samples' rays, in their order (all into one tree).
-    fn trace_queued(
-        &self,
-        queue: &[(usize, Prep)],
-        (single, packets): &mut (raycast::Stack, packet::PacketStack),
-    ) -> Vec<Option<raycast::Hit>> {
-        let pending: Vec<&Pending> =
-            queue.iter().filter_map(|(_, p)| if let Prep::Trace(p) = p { Some(p) } else { None }).collect();
-        let Some(first) = pending.first() else { return Vec::new() };
-        let tree = &self.trees[first.set];
-        if !PACKETS.load(std::sync::atomic::Ordering::Relaxed) {
-            return pending.iter().map(|p| raycast::nearest(tree, &p.ray, p.back, p.front, single)).collect();
-        }
-        let rays: Vec<(raycast::Ray, f32, f32)> = pending.iter().map(|p| (p.ray, p.back, p.front)).collect();
-        let mut out = vec![None; rays.len()];
-        packet::nearest_packet(tree, &rays, &mut out, packets);
-        out
     }
 
     /// One sample from LOW triangle `t` at barycentrics `b`: its ray, or what it gives if it
@@ -324,5 +339,3 @@ impl Tracer<'_> {
         Sample { ts, t: Some(hit.t) }
     }
 }
-
-pub static PACKETS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
