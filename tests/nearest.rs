@@ -314,16 +314,19 @@ fn check(pts: &[[f32; 3]], tris: &[[u32; 3]], rays: &[RaySpec]) -> Result<usize,
     Ok(hits)
 }
 
+/// A ray with how far it reaches behind and ahead, as `nearest_packet` takes it.
+type Reach = (Ray, f32, f32);
+
 /// Packets of the rays with a part of every axis (those a packet walks together; a packet with
 /// another walks each ray alone), then of all the rays in their order, of every size up to
 /// [`PACKET`]: each ray's hit must be the scan's `want`.
-fn in_packets(bvh: &Bvh, wanted: &[((Ray, f32, f32), Option<Found>)]) -> Result<(), TestCaseError> {
+fn in_packets(bvh: &Bvh, wanted: &[(Reach, Option<Found>)]) -> Result<(), TestCaseError> {
     let every_axis = |r: &Ray| r.dir.to_array().iter().all(|&d| (1.0 / d).is_finite());
     let free: Vec<_> = wanted.iter().filter(|(r, _)| every_axis(&r.0)).cloned().collect();
     let mut stack = PacketStack::default();
     for (group, size) in [(&free, PACKET), (&free, 3), (&wanted.to_vec(), PACKET), (&free, 1)] {
         for chunk in group.chunks(size) {
-            let rays: Vec<(Ray, f32, f32)> = chunk.iter().map(|w| w.0).collect();
+            let rays: Vec<Reach> = chunk.iter().map(|w| w.0).collect();
             let mut out = vec![None; rays.len()];
             nearest_packet(bvh, &rays, &mut out, &mut stack);
             for (got, (ray, want)) in out.iter().zip(chunk) {
@@ -425,7 +428,11 @@ fn neighbouring_rays_in_packets_equal_a_scan() {
         (0..=side).flat_map(|j| (0..=side).map(move |i| [i as f32, j as f32, height(i, j)])).collect();
     let at = |i: u32, j: u32| j * (side + 1) + i;
     let tris: Vec<[u32; 3]> = (0..side)
-        .flat_map(|j| (0..side).flat_map(move |i| [[at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]]))
+        .flat_map(|j| {
+            (0..side).flat_map(move |i| {
+                [[at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]]
+            })
+        })
         .collect();
     let mut rays: Vec<RaySpec> = Vec::new();
     // Tiles of 4 x 4 origins a quarter apart, each tile's rays along one direction; every
@@ -435,7 +442,11 @@ fn neighbouring_rays_in_packets_equal_a_scan() {
         let dir = [[0.01, -0.02, -1.0], [0.0, 0.0, -1.0], [0.3, 0.2, -1.0], [-0.25, 0.01, 1.0]][k];
         for b in 0..4 {
             for a in 0..4 {
-                let o = [ti + a as f32 * 0.25 + offset, tj + b as f32 * 0.25 + offset, if dir[2] < 0.0 { 6.0 } else { -2.0 }];
+                let o = [
+                    ti + a as f32 * 0.25 + offset,
+                    tj + b as f32 * 0.25 + offset,
+                    if dir[2] < 0.0 { 6.0 } else { -2.0 },
+                ];
                 rays.push((o, Aim::Any(dir), 9.0, 9.0));
             }
         }

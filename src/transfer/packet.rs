@@ -171,7 +171,8 @@ mod wide {
                     continue;
                 }
                 // SAFETY: eight floats each from `8 * h`.
-                let (lo, hi) = unsafe { (_mm256_loadu_ps(p.lo.as_ptr().add(8 * h)), _mm256_loadu_ps(p.hi.as_ptr().add(8 * h))) };
+                let (lo, hi) =
+                    unsafe { (_mm256_loadu_ps(p.lo.as_ptr().add(8 * h)), _mm256_loadu_ps(p.hi.as_ptr().add(8 * h))) };
                 let (o, inv) = (&p.o[h], &p.inv[h]);
                 let slab = |a: usize| {
                     let t0 = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(n.min[a][lane]), o[a]), inv[a]);

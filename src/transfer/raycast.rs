@@ -265,14 +265,7 @@ pub(super) fn hit_lanes<const FLAT: bool>(n: &WideNode, boxes: &Boxes, lo: f32, 
 /// Tests leaf-order triangle `k` against the ray's part `[lo, hi]`, keeping the best hit and
 /// narrowing the part to what can still beat it.
 #[inline(always)]
-pub(super) fn test_leaf(
-    bvh: &Bvh,
-    ray: &Ray,
-    k: usize,
-    lo: &mut f32,
-    hi: &mut f32,
-    best: &mut Option<Hit>,
-) {
+pub(super) fn test_leaf(bvh: &Bvh, ray: &Ray, k: usize, lo: &mut f32, hi: &mut f32, best: &mut Option<Hit>) {
     let Some((t, bary)) = intersect(ray, bvh.corners(k)) else { return };
     if t < *lo || t > *hi {
         return;
