@@ -321,8 +321,7 @@ type Reach = (Ray, f32, f32);
 /// another walks each ray alone), then of all the rays in their order, of every size up to
 /// [`PACKET`]: each ray's hit must be the scan's `want`.
 fn in_packets(bvh: &Bvh, wanted: &[(Reach, Option<Found>)]) -> Result<(), TestCaseError> {
-    let every_axis = |r: &Ray| r.dir.to_array().iter().all(|&d| (1.0 / d).is_finite());
-    let free: Vec<_> = wanted.iter().filter(|(r, _)| every_axis(&r.0)).cloned().collect();
+    let free: Vec<_> = wanted.iter().filter(|(r, _)| r.0.has_every_axis()).cloned().collect();
     let mut stack = PacketStack::default();
     for (group, size) in [(&free, PACKET), (&free, 3), (&wanted.to_vec(), PACKET), (&free, 1)] {
         for chunk in group.chunks(size) {

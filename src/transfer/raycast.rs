@@ -55,10 +55,16 @@ impl Ray {
         self.inv
     }
 
-    /// Whether the ray has a part of every axis (nearly every ray has): one with none of some
-    /// axis needs the box test's case for it.
-    pub(super) fn has_every_axis(&self) -> bool {
-        self.inv.is_finite()
+    /// Per axis, whether the ray has no part of it: a component so small that its reciprocal
+    /// overflows counts as none, since the ray then stays in the slab it starts in (or out of
+    /// it) however far it goes. The box test needs a case of its own for such an axis.
+    fn flat_axes(&self) -> [bool; 3] {
+        self.inv.to_array().map(|x| x.is_infinite())
+    }
+
+    /// Whether the ray has a part of every axis (nearly every ray has; see `flat_axes`).
+    pub fn has_every_axis(&self) -> bool {
+        !self.flat_axes().contains(&true)
     }
 }
 
@@ -158,7 +164,7 @@ pub fn nearest(bvh: &Bvh, ray: &Ray, back: f32, front: f32, stack: &mut Stack) -
     let boxes = Boxes::of(ray);
     // Nearly every ray has a part of every axis: their walk leaves out the test for one that
     // has none.
-    if boxes.any_flat() {
+    if !ray.has_every_axis() {
         walk::<true>(bvh, ray, &boxes, (-back, front), &mut stack.0)
     } else {
         walk::<false>(bvh, ray, &boxes, (-back, front), &mut stack.0)
@@ -210,25 +216,17 @@ const fn gamma(n: u32) -> f32 {
 
 /// What every box test of one ray shares: its origin and reciprocal direction, one lane per
 /// child, and which axes it has no part of.
-pub(super) struct Boxes {
+struct Boxes {
     o: [Vec4; 3],
     inv: [Vec4; 3],
     flat: [bool; 3],
 }
 
 impl Boxes {
-    pub(super) fn of(ray: &Ray) -> Boxes {
+    fn of(ray: &Ray) -> Boxes {
         let o = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
         let inv = [Vec4::splat(ray.inv.x), Vec4::splat(ray.inv.y), Vec4::splat(ray.inv.z)];
-        // A component so small that its reciprocal overflows counts as none: the ray then stays
-        // in the slab it starts in (or out of it) however far it goes.
-        let flat = ray.inv.to_array().map(|x| x.is_infinite());
-        Boxes { o, inv, flat }
-    }
-
-    /// Whether the ray has no part of some axis (its walk must then test for it).
-    pub(super) fn any_flat(&self) -> bool {
-        self.flat.contains(&true)
+        Boxes { o, inv, flat: ray.flat_axes() }
     }
 }
 
@@ -236,7 +234,7 @@ impl Boxes {
 /// child), and how far each box's part of the ray lies from the origin; `FLAT` when the ray has
 /// no part of some axis.
 #[inline(always)]
-pub(super) fn hit_lanes<const FLAT: bool>(n: &WideNode, boxes: &Boxes, lo: f32, hi: f32) -> (BVec4A, Vec4) {
+fn hit_lanes<const FLAT: bool>(n: &WideNode, boxes: &Boxes, lo: f32, hi: f32) -> (BVec4A, Vec4) {
     let Boxes { o, inv, flat } = boxes;
     let slab = |a: usize| {
         if FLAT && flat[a] {
@@ -302,38 +300,41 @@ fn visit<const FLAT: bool>(
     }
     let n = &bvh.nodes[todo.child as usize];
     let (hits, gaps) = hit_lanes::<FLAT>(n, boxes, *lo, *hi);
-    let mut mask = hits.bitmask() & n.lanes;
+    let mask = hits.bitmask() & n.lanes;
     if mask == 0 {
         return None;
     }
     let gaps = gaps.to_array();
     let kid = |lane: usize| Todo { child: n.child[lane], count: n.count[lane] as u32, gap: gaps[lane] };
-    // The nearest child is visited next (ties: the lower lane); the others are pushed farthest
-    // first, so they pop nearest first.
-    let first = mask.trailing_zeros() as usize;
+    let (next, rest) = nearest_first(mask, &gaps);
+    stack.extend(rest.map(kid));
+    Some(kid(next))
+}
+
+/// The order a walk takes the children in `mask` (bit `k` for child `k`, at least one) at
+/// distances `dist`: the nearest is visited next (ties: the lower lane), the others, returned
+/// farthest first, are pushed so that they pop nearest first.
+#[inline(always)]
+pub(super) fn nearest_first(mut mask: u32, dist: &[f32; 4]) -> (usize, impl Iterator<Item = usize>) {
+    let mut next = mask.trailing_zeros() as usize;
     mask &= mask - 1;
-    let mut next = kid(first);
-    if mask == 0 {
-        return Some(next);
-    }
     let mut rest = [next; 3];
     let mut len = 0;
     while mask != 0 {
-        let mut k = kid(mask.trailing_zeros() as usize);
+        let mut l = mask.trailing_zeros() as usize;
         mask &= mask - 1;
-        if k.gap < next.gap {
-            std::mem::swap(&mut k, &mut next);
+        if dist[l] < dist[next] {
+            std::mem::swap(&mut l, &mut next);
         }
         let mut i = len;
-        while i > 0 && rest[i - 1].gap <= k.gap {
+        while i > 0 && dist[rest[i - 1]] <= dist[l] {
             rest[i] = rest[i - 1];
             i -= 1;
         }
-        rest[i] = k;
+        rest[i] = l;
         len += 1;
     }
-    stack.extend_from_slice(&rest[..len]);
-    Some(next)
+    (next, rest.into_iter().take(len))
 }
 
 #[cfg(test)]
