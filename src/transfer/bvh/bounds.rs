@@ -45,10 +45,10 @@ pub(super) struct Item {
 }
 
 impl Item {
-    /// Triangle `id`'s item, its corners `t` indices into `positions`.
-    pub fn of(positions: &[[f32; 3]], t: [u32; 3], id: u32) -> Item {
+    /// Triangle `id`'s item, its corners `c`.
+    pub fn of(c: &[[f32; 3]; 3], id: u32) -> Item {
         let mut b = Aabb::EMPTY;
-        t.iter().for_each(|&k| b.grow(Vec3A::from(positions[k as usize])));
+        c.iter().for_each(|&p| b.grow(Vec3A::from(p)));
         Item { min: b.min.to_array(), max: b.max.to_array(), id }
     }
 

@@ -17,6 +17,8 @@ pub(super) struct Local {
     /// Per axis, the order the small-range split sorts by as one integer: the centre's bits made
     /// to order as the floats do, above the item's id (which breaks ties as the input's order).
     pub key: [[u64; LOCAL]; 3],
+    /// How many triangles each item holds (1, or 2 for a pair).
+    pub weight: [u8; LOCAL],
 }
 
 thread_local! {
@@ -28,6 +30,7 @@ thread_local! {
         centre: [Vec3A::ZERO; LOCAL],
         along: [[0.0; LOCAL]; 3],
         key: [[0; LOCAL]; 3],
+        weight: [0; LOCAL],
     }));
 }
 
@@ -37,10 +40,11 @@ impl Local {
         BUFFER.with(|b| f(&mut b.borrow_mut()))
     }
 
-    /// Copies `it` into place `i`, with its box, centre and sort keys.
+    /// Copies `it` (of `weight` triangles) into place `i`, with its box, centre and sort keys.
     #[inline]
-    pub fn set(&mut self, i: usize, it: Item) {
+    pub fn set(&mut self, i: usize, it: Item, weight: u8) {
         self.was[i] = it;
+        self.weight[i] = weight;
         self.bounds[i] = it.bounds();
         let c = it.centre();
         self.centre[i] = c;

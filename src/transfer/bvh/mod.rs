@@ -18,6 +18,7 @@ mod cost;
 mod local;
 mod morton;
 mod node;
+mod pairs;
 mod range;
 mod sah;
 mod small;
@@ -70,7 +71,8 @@ impl Bvh {
         if n == 0 {
             return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
         }
-        let item = |i: usize| Item::of(positions, triangles[i], i as u32);
+        let corners = |i: usize| triangles[i].map(|k| positions[k as usize]);
+        let item = |i: usize| Item::of(&corners(i), i as u32);
         let tri = |i: u32| {
             let t = triangles[i as usize];
             Tri { corners: t.map(|k| positions[k as usize]), index: index(i).unwrap_or(t) }
@@ -78,7 +80,7 @@ impl Bvh {
         if morton::applies(n) {
             // Each range writes its triangles in leaf order as it ends, while they are cached:
             // no array of items, no pass of its own over HIGH in leaf order.
-            let (upper, ids, tris) = morton::build(n, &item, &tri);
+            let (upper, ids, tris) = morton::build(n, &corners, &item, &tri);
             drop(triangles);
             return Bvh { nodes: upper.collapse(), ids, tris };
         }

@@ -1,11 +1,12 @@
 //! The upper levels of a large tree, split at Morton-code boundaries: one sort, then no pass
 //! over every item per level. Binned SAH builds only ranges of [`SAH_RANGE`] or fewer, whose
-//! items fit in a core's cache.
+//! items fit in a core's cache. An item is a triangle or a pair of neighbours (`pairs.rs`).
 
-use super::bounds::{bounds_by, bounds_of, Aabb, Item};
+use super::bounds::{bounds_of, Aabb, Item};
 use super::collapse::Upper;
 use super::local::LOCAL;
 use super::node::Node;
+use super::pairs::{self, Pairs};
 use super::range;
 use super::sah;
 use super::Tri;
@@ -36,47 +37,81 @@ pub(super) fn applies(n: usize) -> bool {
     (MORTON_MIN..1 << INDEX_BITS).contains(&n)
 }
 
-/// Builds the tree over the `n` triangles whose items `item` gives, in the order of the Morton
-/// codes of their centres; returns it, the triangles' ids in leaf order and `tri` of each id in
-/// that order. The items are never gathered into that order: each range computes its own from
-/// the mesh, and writes its triangles in leaf order into their place.
-pub(super) fn build<I, T>(n: usize, item: &I, tri: &T) -> (Upper, Vec<u32>, Vec<Tri>)
+/// Builds the tree over the `n` triangles whose corners `corners` gives and whose boxes `item`
+/// gives, its items in the order of the Morton codes of their centres; returns it, the
+/// triangles' ids in leaf order and `tri` of each id in that order. The items are never
+/// gathered into that order: each range computes its own from the mesh, and writes its
+/// triangles in leaf order into their place.
+pub(super) fn build<C, I, T>(n: usize, corners: &C, item: &I, tri: &T) -> (Upper, Vec<u32>, Vec<Tri>)
 where
+    C: Fn(usize) -> [[f32; 3]; 3] + Sync,
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
 {
-    use rayon::prelude::*;
-    let (_, centres) = bounds_by(n, item);
-    let mut keys = morton_keys(n, |i| item(i).centre(), &centres);
-    let mut tris: Vec<Tri> = Vec::with_capacity(n);
-    let upper = build_upper(&Mesh { item, tri }, &mut keys, &mut tris.spare_capacity_mut()[..n], 0);
-    // SAFETY: the ranges split the keys without gaps, the slots in step with them, and each
-    // range writes every slot of its own (`range`), so all `n` are written.
-    unsafe { tris.set_len(n) };
-    // Each range has left its ids in leaf order where its keys were.
-    let ids = keys.par_iter().map(|&k| k as u32).collect();
+    let found = pairs::find(n, corners);
+    let pairs = found.pairs;
+    let mut keys = morton_keys(&found.ids, |t| pairs.item(t, item).centre(), &found.centres);
+    drop(found.ids);
+    let starts = triangle_starts(&keys, &pairs);
+    let (mut tris, mut ids): (Vec<Tri>, Vec<u32>) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let out = Out { tris: &mut tris.spare_capacity_mut()[..n], ids: &mut ids.spare_capacity_mut()[..n] };
+    let upper = build_upper(&Mesh { item, tri, pairs: &pairs }, &mut keys, &starts, out);
+    // SAFETY: the ranges split the keys without gaps, the slots in step with their triangles,
+    // and each range writes every slot of its own (`range`), so all `n` are written.
+    unsafe {
+        tris.set_len(n);
+        ids.set_len(n);
+    }
     (upper, ids, tris)
 }
 
-/// What the ranges read the mesh through: a triangle's item, and its record in leaf order.
+/// What the ranges read the mesh through: a triangle's item, its record in leaf order, and
+/// which triangles are paired.
 struct Mesh<'a, I, T> {
     item: &'a I,
     tri: &'a T,
+    pairs: &'a Pairs,
 }
 
-/// Each item's key (Morton code of its box's centre over the centres' bounds `c`, then its
-/// index), sorted.
-fn morton_keys(n: usize, centre: impl Fn(usize) -> Vec3A + Sync, c: &Aabb) -> Vec<u64> {
+/// Where a range writes its triangles and their ids, in leaf order.
+struct Out<'a> {
+    tris: &'a mut [MaybeUninit<Tri>],
+    ids: &'a mut [MaybeUninit<u32>],
+}
+
+impl<'a> Out<'a> {
+    fn split_at(self, k: usize) -> (Out<'a>, Out<'a>) {
+        let (ta, tb) = self.tris.split_at_mut(k);
+        let (ia, ib) = self.ids.split_at_mut(k);
+        (Out { tris: ta, ids: ia }, Out { tris: tb, ids: ib })
+    }
+}
+
+/// Where each sorted key's triangles start in leaf order: the sizes of the items before it.
+fn triangle_starts(keys: &[u64], pairs: &Pairs) -> Vec<u32> {
     use rayon::prelude::*;
+    let mut starts: Vec<u32> = keys.par_iter().map(|&k| pairs.size((k & INDEX_MASK) as u32)).collect();
+    let mut at = 0;
+    for s in starts.iter_mut() {
+        (*s, at) = (at, at + *s);
+    }
+    starts
+}
+
+/// Each item's key (Morton code of its box's centre over the centres' bounds `c`, then its id
+/// from `ids`), sorted.
+fn morton_keys(ids: &[u32], centre: impl Fn(u32) -> Vec3A + Sync, c: &Aabb) -> Vec<u64> {
+    use rayon::prelude::*;
+    let n = ids.len();
     let cells = (1u32 << AXIS_BITS) as f32;
     let extent = c.max - c.min;
     let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
-    let keys: Vec<u64> = (0..n)
-        .into_par_iter()
-        .map(|i| {
+    let keys: Vec<u64> = ids
+        .par_iter()
+        .map(|&i| {
             let q = ((centre(i) - c.min) * scale).min(Vec3A::splat(cells - 1.0));
             let code = spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2;
-            code << INDEX_BITS | i as u64
+            code << INDEX_BITS | u64::from(i)
         })
         .collect();
     // One pass on the code's top bits into buckets, then each bucket sorted on its own, on every
@@ -175,11 +210,11 @@ fn upper_bounds(u: &Upper) -> Aabb {
     Aabb { min: Vec3A::from(n.min), max: Vec3A::from(n.max) }
 }
 
-/// The upper levels over the items `keys` names (sorted, each a code above an index into the
-/// mesh): each split where the codes' highest differing bit flips; ranges of [`SAH_RANGE`] or
-/// fewer (or of one code) are built by binned SAH. Leaves each key holding its item's id, and
-/// each slot of `out` its triangle, in leaf order.
-fn build_upper<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], out: &mut [MaybeUninit<Tri>], offset: usize) -> Upper
+/// The upper levels over the items `keys` names (sorted, each a code above an item's id), whose
+/// triangles start at `starts` in leaf order: each split where the codes' highest differing bit
+/// flips; ranges of [`SAH_RANGE`] or fewer (or of one code) are built by binned SAH. Writes
+/// each slot of `out` (as many as the items' triangles), in leaf order.
+fn build_upper<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], starts: &[u32], out: Out) -> Upper
 where
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
@@ -187,47 +222,58 @@ where
     let code = |k: u64| k >> INDEX_BITS;
     let (first, last) = (code(keys[0]), code(keys[keys.len() - 1]));
     if keys.len() <= SAH_RANGE || first == last {
-        return Upper::range(range(mesh, keys, out, offset));
+        return Upper::range(range(mesh, keys, starts[0] as usize, out));
     }
     let bit = 63 - (first ^ last).leading_zeros();
     let mid = keys.partition_point(|&k| code(k) >> bit & 1 == 0);
     let (l, r) = keys.split_at_mut(mid);
-    let (lo, ro) = out.split_at_mut(mid);
+    let (ls, rs) = starts.split_at(mid);
+    let (lo, ro) = out.split_at((rs[0] - ls[0]) as usize);
     let (left, right) = if l.len() + r.len() < SERIAL_BELOW {
-        (build_upper(mesh, l, lo, offset), build_upper(mesh, r, ro, offset + mid))
+        (build_upper(mesh, l, ls, lo), build_upper(mesh, r, rs, ro))
     } else {
-        rayon::join(|| build_upper(mesh, l, lo, offset), || build_upper(mesh, r, ro, offset + mid))
+        rayon::join(|| build_upper(mesh, l, ls, lo), || build_upper(mesh, r, rs, ro))
     };
     let mut b = upper_bounds(&left);
     b.join(&upper_bounds(&right));
     Upper::Split(Node::inner(&b, 0), Box::new(left), Box::new(right))
 }
 
-/// The binary tree over the range of items `keys` names, starting at `offset` in leaf order;
-/// writes every slot of `out` (as many as `keys`).
-fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], out: &mut [MaybeUninit<Tri>], offset: usize) -> Vec<Node>
+/// The binary tree over the range of items `keys` names, their triangles starting at `offset`
+/// in leaf order; writes every slot of `out`.
+fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], offset: usize, out: Out) -> Vec<Node>
 where
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
 {
     keys.iter_mut().for_each(|k| *k &= INDEX_MASK);
-    let nodes = if keys.len() <= LOCAL {
+    let triangles = |k: &u64| (*k as u32..).take(mesh.pairs.size(*k as u32) as usize);
+    if keys.len() <= LOCAL {
         let mut nodes = Vec::with_capacity(keys.len() / 2 + 1);
-        range::build_by_index(mesh.item, keys, offset, &mut nodes);
-        nodes
-    } else {
-        // Many items with one code (a pile of duplicates): gathered, then split by count.
-        let mut gathered: Vec<Item> = keys.iter().map(|&k| (mesh.item)(k as usize)).collect();
-        let bc = bounds_of(&gathered);
-        let nodes = sah::build_par(&mut gathered, offset, bc);
-        keys.iter_mut().zip(&gathered).for_each(|(k, it)| *k = u64::from(it.id));
-        nodes
-    };
-    // The range's triangles were just read for their items: they are still in cache.
-    for (slot, &k) in out.iter_mut().zip(keys.iter()) {
-        slot.write((mesh.tri)(k as u32));
+        let item = |t: usize| (mesh.pairs.item(t as u32, mesh.item), mesh.pairs.size(t as u32) as u8);
+        range::build_by_index(item, keys, offset, &mut nodes);
+        write(mesh, out, keys.iter().flat_map(triangles));
+        return nodes;
     }
+    // Many items with one code (a pile of duplicates): their triangles gathered one by one, then
+    // split by count.
+    let mut gathered: Vec<Item> = keys.iter().flat_map(triangles).map(|t| (mesh.item)(t as usize)).collect();
+    let bc = bounds_of(&gathered);
+    let nodes = sah::build_par(&mut gathered, offset, bc);
+    write(mesh, out, gathered.iter().map(|it| it.id));
     nodes
+}
+
+/// Writes the triangles `ids` (as many as `out` has slots) and their ids into `out`: the range's
+/// triangles were just read for their items, and are still in cache.
+fn write<I, T: Fn(u32) -> Tri>(mesh: &Mesh<I, T>, out: Out, ids: impl Iterator<Item = u32>) {
+    let mut n = 0;
+    for ((slot, id), t) in out.tris.iter_mut().zip(out.ids.iter_mut()).zip(ids) {
+        slot.write((mesh.tri)(t));
+        id.write(t);
+        n += 1;
+    }
+    assert_eq!(n, out.tris.len(), "a range writes every slot of its own");
 }
 
 #[cfg(test)]
@@ -269,14 +315,15 @@ mod tests {
             .collect();
         let (_, c) = bounds_of(&items);
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
-        let centre = |i: usize| items[i].centre();
-        let keys = one.install(|| morton_keys(items.len(), centre, &c));
+        let centre = |i: u32| items[i as usize].centre();
+        let ids: Vec<u32> = (0..items.len() as u32).collect();
+        let keys = one.install(|| morton_keys(&ids, centre, &c));
         assert!(keys.windows(2).all(|w| w[0] < w[1]));
         let mut ids: Vec<u64> = keys.iter().map(|k| k & INDEX_MASK).collect();
         ids.sort_unstable();
         assert!(ids.iter().enumerate().all(|(i, &k)| k == i as u64), "every item once");
         let three = rayon::ThreadPoolBuilder::new().num_threads(3).build().expect("pool");
-        assert_eq!(three.install(|| morton_keys(items.len(), centre, &c)), keys);
+        assert_eq!(three.install(|| morton_keys(&ids, centre, &c)), keys);
     }
 
     #[test]

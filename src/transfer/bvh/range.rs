@@ -16,7 +16,7 @@ use super::small;
 pub(super) fn build(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, bc: (Aabb, Aabb)) {
     debug_assert!((1..=LOCAL).contains(&items.len()));
     Local::with(|l| {
-        items.iter().enumerate().for_each(|(i, &it)| l.set(i, it));
+        items.iter().enumerate().for_each(|(i, &it)| l.set(i, it, 1));
         let idx = l.run(items.len(), offset, nodes, bc);
         for (it, &i) in items.iter_mut().zip(&idx) {
             *it = l.was[i as usize];
@@ -24,14 +24,21 @@ pub(super) fn build(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, bc
     });
 }
 
-/// [`build`] over the items `item(k)` for each `k` in `ids` (at most [`LOCAL`]), made where
-/// they are rather than gathered first; leaves `ids` holding the items' ids in leaf order.
-pub(super) fn build_by_index(item: impl Fn(usize) -> Item, ids: &mut [u64], offset: usize, nodes: &mut Vec<Node>) {
+/// [`build`] over the items `item(k)` for each `k` in `ids` (at most [`LOCAL`]), each with the
+/// count of triangles it holds, made where they are rather than gathered first; `offset` and
+/// the leaves count triangles. Leaves `ids` holding the items' ids in leaf order.
+pub(super) fn build_by_index(
+    item: impl Fn(usize) -> (Item, u8),
+    ids: &mut [u64],
+    offset: usize,
+    nodes: &mut Vec<Node>,
+) {
     debug_assert!((1..=LOCAL).contains(&ids.len()));
     Local::with(|l| {
         let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
         for (i, &k) in ids.iter().enumerate() {
-            l.set(i, item(k as usize));
+            let (it, weight) = item(k as usize);
+            l.set(i, it, weight);
             b.join(&l.bounds[i]);
             c.grow(l.centre[i]);
         }
@@ -47,34 +54,36 @@ impl Local {
     fn run(&self, n: usize, offset: usize, nodes: &mut Vec<Node>, bc: (Aabb, Aabb)) -> [u8; LOCAL] {
         let mut idx = [0u8; LOCAL];
         idx.iter_mut().take(n).enumerate().for_each(|(i, x)| *x = i as u8);
-        self.serial(&mut idx[..n], offset, nodes, bc);
+        let weight = self.weight[..n].iter().map(|&w| w as usize).sum();
+        self.serial(&mut idx[..n], offset, nodes, bc, weight);
         idx
     }
 
-    /// As `sah::build_serial`, over the items `idx`, which it leaves in leaf order.
-    fn serial(&self, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, (b, c): (Aabb, Aabb)) {
+    /// As `sah::build_serial`, over the items `idx` (holding `weight` triangles), which it
+    /// leaves in leaf order.
+    fn serial(&self, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, (b, c): (Aabb, Aabb), weight: usize) {
         if idx.len() <= SMALL {
             small::build(self, idx, offset, nodes, b);
             return;
         }
         let me = nodes.len();
-        let (mid, lb, rb) = match self.split(idx, &b, &c) {
-            Some((sp, which)) => (partition(idx, &which, sp.bin), sp.left, sp.right),
-            None if idx.len() <= MAX_LEAF * 2 => {
-                nodes.push(Node::leaf(&b, offset, idx.len()));
+        let (mid, left, lb, rb) = match self.split(idx, &b, &c, weight) {
+            Some((sp, which)) => (partition(idx, &which, sp.bin), sp.left_count, sp.left, sp.right),
+            None if weight <= MAX_LEAF * 2 => {
+                nodes.push(Node::leaf(&b, offset, weight));
                 return;
             }
             None => self.halves(idx),
         };
         nodes.push(Node::inner(&b, 0));
         let (l, r) = idx.split_at_mut(mid);
-        self.serial(l, offset, nodes, lb);
+        self.serial(l, offset, nodes, lb, left);
         nodes[me].right_or_first = nodes.len() as u32;
-        self.serial(r, offset + mid, nodes, rb);
+        self.serial(r, offset + left, nodes, rb, weight - left);
     }
 
     /// As `sah::split`, with each item's bin (by its place in `idx`) for the partition.
-    fn split(&self, idx: &[u8], b: &Aabb, c: &Aabb) -> Option<(cost::Split, [u8; LOCAL])> {
+    fn split(&self, idx: &[u8], b: &Aabb, c: &Aabb, weight: usize) -> Option<(cost::Split, [u8; LOCAL])> {
         let extent = c.max - c.min;
         let axis = cost::longest(extent);
         let e = extent[axis];
@@ -92,15 +101,17 @@ impl Local {
             let k = (((along[i] - lo) * scale) as u32).min(BINS as u32 - 1) as usize;
             bins[k].0.join(&self.bounds[i]);
             bins[k].1.grow(self.centre[i]);
-            bins[k].2 += 1;
+            bins[k].2 += self.weight[i] as usize;
             *w = k as u8;
         }
-        cost::choose(&bins, idx.len(), b, axis).map(|sp| (sp, which))
+        cost::choose(&bins, weight, b, axis).map(|sp| (sp, which))
     }
 
-    /// As `sah::halves`: two halves of equal count (centres that cannot be told apart).
-    fn halves(&self, idx: &[u8]) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
+    /// As `sah::halves`: two halves of equal count (centres that cannot be told apart), and the
+    /// triangles the first holds.
+    fn halves(&self, idx: &[u8]) -> (usize, usize, (Aabb, Aabb), (Aabb, Aabb)) {
         let mid = idx.len() / 2;
+        let left = idx[..mid].iter().map(|&i| self.weight[i as usize] as usize).sum();
         let bounds = |s: &[u8]| {
             let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
             for &i in s {
@@ -109,7 +120,7 @@ impl Local {
             }
             (b, c)
         };
-        (mid, bounds(&idx[..mid]), bounds(&idx[mid..]))
+        (mid, left, bounds(&idx[..mid]), bounds(&idx[mid..]))
     }
 }
 

@@ -9,8 +9,8 @@ use super::cost::{longest, MAX_LEAF, NODE_COST, SMALL};
 use super::local::Local;
 use super::node::Node;
 
-/// Builds the subtree over the items `idx` of `l` (at most [`SMALL`], starting at `offset` in
-/// leaf order, with bounds `b`) into `nodes`, and leaves `idx` in leaf order.
+/// Builds the subtree over the items `idx` of `l` (at most [`SMALL`], their triangles starting
+/// at `offset` in leaf order, with bounds `b`) into `nodes`, and leaves `idx` in leaf order.
 pub(super) fn build(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb) {
     debug_assert!((1..=SMALL).contains(&idx.len()));
     node(l, idx, offset, nodes, b, None);
@@ -20,7 +20,7 @@ pub(super) fn build(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<No
 fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb, sorted: Option<usize>) {
     let len = idx.len();
     if len == 1 {
-        nodes.push(Node::leaf(&b, offset, 1));
+        nodes.push(Node::leaf(&b, offset, l.weight[idx[0] as usize] as usize));
         return;
     }
     let mut c = Aabb::EMPTY;
@@ -39,10 +39,16 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
             idx[j] = x;
         }
     }
+    // Triangles before each place (an item may be a pair, `pairs.rs`).
+    let mut before = [0usize; SMALL + 1];
+    for t in 0..len {
+        before[t + 1] = before[t] + l.weight[idx[t] as usize] as usize;
+    }
+    let weight = before[len];
     // Two triangles always make a leaf: splitting costs the node visit (`NODE_COST`, two
     // triangle tests) on top of each side's one.
-    if len == 2 && NODE_COST >= 2.0 {
-        nodes.push(Node::leaf(&b, offset, len));
+    if weight == 2 && NODE_COST >= 2.0 {
+        nodes.push(Node::leaf(&b, offset, weight));
         return;
     }
     // Both sweeps in one loop, for two chains of joins the core runs side by side: `left[k]` and
@@ -54,10 +60,10 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
     for t in 1..len {
         accl.join(bounds(t - 1));
         left[t] = accl;
-        la[t] = accl.area() * t as f32;
+        la[t] = accl.area() * before[t] as f32;
         accr.join(bounds(len - t));
         right[len - t] = accr;
-        ra[len - t] = accr.area() * t as f32;
+        ra[len - t] = accr.area() * (weight - before[len - t]) as f32;
     }
     let mut best = (f32::INFINITY, 0);
     for k in 1..len {
@@ -68,8 +74,8 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
     }
     let (cost, k) = best;
     // As in `sah::split`: a node visit costs two triangle tests.
-    if len <= MAX_LEAF && cost + NODE_COST * b.area() >= b.area() * len as f32 {
-        nodes.push(Node::leaf(&b, offset, len));
+    if weight <= MAX_LEAF && cost + NODE_COST * b.area() >= b.area() * weight as f32 {
+        nodes.push(Node::leaf(&b, offset, weight));
         return;
     }
     // No finite cost (boxes too large for f32 areas): halves.
@@ -80,5 +86,5 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
     let (lo, hi) = idx.split_at_mut(k);
     node(l, lo, offset, nodes, lb, Some(axis));
     nodes[me].right_or_first = nodes.len() as u32;
-    node(l, hi, offset + k, nodes, rb, Some(axis));
+    node(l, hi, offset + before[k], nodes, rb, Some(axis));
 }
