@@ -383,17 +383,17 @@ fn nearest_equals_a_scan_on_large_soups() {
         // Vertices on a grid of 1/8 over a 48-unit cube: coplanar and repeated corners abound.
         let mut grid = || (next() % 385) as f32 * 0.125 - 24.0;
         let pts: Vec<[f32; 3]> = (0..n).map(|_| [grid(), grid(), grid()]).collect();
-        let tris: Vec<[u32; 3]> = (0..n as u32)
-            .map(|i| {
-                // Small triangles near vertex i, one in 16 with a repeated corner.
-                let mut j = |d: u32| (i + 1 + next() % d) % n as u32;
-                if i % 16 == 0 {
-                    [i, j(8), i]
-                } else {
-                    [i, j(8), j(8)]
-                }
-            })
-            .collect();
+        let mut tris: Vec<[u32; 3]> = Vec::with_capacity(n);
+        for i in 0..n as u32 {
+            // Small triangles near vertex i, one in 16 with a repeated corner, one in 4 sharing
+            // an edge with the one before (a pair the large build makes one item of).
+            let mut j = |d: u32| (i + 1 + next() % d) % n as u32;
+            tris.push(match (i % 16, tris.last()) {
+                (0, _) => [i, j(8), i],
+                (1 | 5 | 9 | 13, Some(&[a, _, c])) => [a, c, j(8)],
+                _ => [i, j(8), j(8)],
+            });
+        }
         let mut rng = || next();
         let rays: Vec<RaySpec> = (0..60)
             .map(|k| {
@@ -421,7 +421,13 @@ fn nearest_equals_a_scan_on_large_soups() {
 /// packets gets the scan's hit.
 #[test]
 fn neighbouring_rays_in_packets_equal_a_scan() {
-    let side = 48u32;
+    // The second terrace has enough triangles for the large build, which pairs a quad's halves.
+    for side in [48u32, 184] {
+        terrace(side);
+    }
+}
+
+fn terrace(side: u32) {
     let height = |i: u32, j: u32| ((i / 6 + j / 9) % 4) as f32;
     let pts: Vec<[f32; 3]> =
         (0..=side).flat_map(|j| (0..=side).map(move |i| [i as f32, j as f32, height(i, j)])).collect();

@@ -192,6 +192,22 @@ pub(crate) mod tests {
         assert!(bvh.nodes.len() * 4 < tris.len(), "{} nodes", bvh.nodes.len());
     }
 
+    /// On a large HIGH a quad's two halves are one item (`pairs.rs`): side by side in one leaf.
+    #[test]
+    fn a_quads_halves_share_a_leaf() {
+        let tris = grid_tris(200);
+        assert!(tris.len() >= morton::MORTON_MIN);
+        let (bvh, _) = soup(&tris);
+        let mut at = vec![0usize; tris.len()];
+        bvh.ids.iter().enumerate().for_each(|(k, &id)| at[id as usize] = k);
+        let starts: std::collections::HashSet<u32> =
+            bvh.nodes.iter().flat_map(|n| (0..4).filter(|&k| n.has(k) && n.is_leaf(k)).map(|k| n.child[k])).collect();
+        for q in 0..tris.len() / 2 {
+            let (a, b) = (at[2 * q], at[2 * q + 1]);
+            assert!(b == a + 1 && !starts.contains(&(b as u32)), "quad {q}: its halves at {a} and {b}");
+        }
+    }
+
     /// The same tree, node for node, whatever the thread count (large enough for the parallel
     /// binning and the parallel subtrees).
     #[test]

@@ -319,9 +319,9 @@ mod tests {
         let ids: Vec<u32> = (0..items.len() as u32).collect();
         let keys = one.install(|| morton_keys(&ids, centre, &c));
         assert!(keys.windows(2).all(|w| w[0] < w[1]));
-        let mut ids: Vec<u64> = keys.iter().map(|k| k & INDEX_MASK).collect();
-        ids.sort_unstable();
-        assert!(ids.iter().enumerate().all(|(i, &k)| k == i as u64), "every item once");
+        let mut seen: Vec<u64> = keys.iter().map(|k| k & INDEX_MASK).collect();
+        seen.sort_unstable();
+        assert!(seen.iter().enumerate().all(|(i, &k)| k == i as u64), "every item once");
         let three = rayon::ThreadPoolBuilder::new().num_threads(3).build().expect("pool");
         assert_eq!(three.install(|| morton_keys(&ids, centre, &c)), keys);
     }

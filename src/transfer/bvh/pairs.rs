@@ -18,11 +18,10 @@ pub(super) struct Pairs {
 }
 
 /// What one pass over the triangles gives: the pairs, each item's id (its first triangle) in
-/// input order, and the items' bounds and centre bounds.
+/// input order, and the bounds of the items' centres.
 pub(super) struct Found {
     pub pairs: Pairs,
     pub ids: Vec<u32>,
-    pub bounds: Aabb,
     pub centres: Aabb,
 }
 
@@ -56,13 +55,13 @@ fn joined(mut it: Item, o: &Item) -> Item {
 /// chunk; `corners(t)` gives triangle `t`'s corners.
 pub(super) fn find(n: usize, corners: impl Fn(usize) -> [[f32; 3]; 3] + Sync) -> Found {
     use rayon::prelude::*;
-    let chunks: Vec<(Vec<u64>, Vec<u32>, Aabb, Aabb)> = (0..n.div_ceil(CHUNK))
+    let chunks: Vec<(Vec<u64>, Vec<u32>, Aabb)> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
             let (start, end) = (c * CHUNK, n.min((c + 1) * CHUNK));
             let mut words = vec![0u64; (end - start).div_ceil(64)];
             let mut ids = Vec::with_capacity((end - start) / 2 + 1);
-            let (mut b, mut cb) = (Aabb::EMPTY, Aabb::EMPTY);
+            let mut centres = Aabb::EMPTY;
             let mut t = start;
             let mut next = (t < end).then(|| corners(t));
             while let Some(a) = next {
@@ -81,22 +80,20 @@ pub(super) fn find(n: usize, corners: impl Fn(usize) -> [[f32; 3]; 3] + Sync) ->
                         next = after;
                     }
                 }
-                b.join(&it.bounds());
-                cb.grow(it.centre());
+                centres.grow(it.centre());
             }
-            (words, ids, b, cb)
+            (words, ids, centres)
         })
         .collect();
     let mut first = Vec::with_capacity(n.div_ceil(64));
     let mut ids = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
-    let (mut bounds, mut centres) = (Aabb::EMPTY, Aabb::EMPTY);
-    for (w, i, b, c) in chunks {
+    let mut centres = Aabb::EMPTY;
+    for (w, i, c) in chunks {
         first.extend(w);
         ids.extend(i);
-        bounds.join(&b);
         centres.join(&c);
     }
-    Found { pairs: Pairs { first }, ids, bounds, centres }
+    Found { pairs: Pairs { first }, ids, centres }
 }
 
 /// Whether two of `b`'s corners are at positions of `a`'s (bit for bit: the corners a mesh
@@ -137,7 +134,7 @@ mod tests {
         assert_eq!(f.ids.iter().map(|&t| f.pairs.size(t)).collect::<Vec<_>>(), vec![2, 1, 2, 1]);
         let pair = f.pairs.item(3, |t| tri_item(&tris[t], t as u32));
         assert_eq!((pair.min, pair.max, pair.id), ([8.0, 9.0, 0.0], [10.0, 10.0, 0.0], 3));
-        assert_eq!((f.bounds.min.to_array(), f.bounds.max.to_array()), ([0.0; 3], [10.0, 10.0, 0.0]));
+        assert_eq!((f.centres.min.to_array(), f.centres.max.to_array()), ([0.5, 0.5, 0.0], [9.0, 9.5, 0.0]));
 
         // A strip of quads across a chunk's end: the quad that straddles it is two items.
         let quads = CHUNK / 2 + 1;

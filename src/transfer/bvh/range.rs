@@ -67,7 +67,7 @@ impl Local {
             return;
         }
         let me = nodes.len();
-        let (mid, left, lb, rb) = match self.split(idx, &b, &c, weight) {
+        let (mid, left, lb, rb) = match self.split(idx, &c, weight) {
             Some((sp, which)) => (partition(idx, &which, sp.bin), sp.left_count, sp.left, sp.right),
             None if weight <= MAX_LEAF * 2 => {
                 nodes.push(Node::leaf(&b, offset, weight));
@@ -83,7 +83,7 @@ impl Local {
     }
 
     /// As `sah::split`, with each item's bin (by its place in `idx`) for the partition.
-    fn split(&self, idx: &[u8], b: &Aabb, c: &Aabb, weight: usize) -> Option<(cost::Split, [u8; LOCAL])> {
+    fn split(&self, idx: &[u8], c: &Aabb, weight: usize) -> Option<(cost::Split, [u8; LOCAL])> {
         let extent = c.max - c.min;
         let axis = cost::longest(extent);
         let e = extent[axis];
@@ -104,7 +104,7 @@ impl Local {
             bins[k].2 += self.weight[i] as usize;
             *w = k as u8;
         }
-        cost::choose(&bins, weight, b, axis).map(|sp| (sp, which))
+        cost::choose(&bins, weight, axis).map(|sp| (sp, which))
     }
 
     /// As `sah::halves`: two halves of equal count (centres that cannot be told apart), and the

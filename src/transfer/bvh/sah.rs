@@ -21,7 +21,7 @@ pub(super) fn build_par(items: &mut [Item], offset: usize, bc: (Aabb, Aabb)) -> 
         return nodes;
     }
     let (b, c) = bc;
-    let (mid, lb, rb) = divide(items, &b, &c);
+    let (mid, lb, rb) = divide(items, &c);
     let (l, r) = items.split_at_mut(mid);
     let (mut left, mut right) = rayon::join(|| build_par(l, offset, lb), || build_par(r, offset + mid, rb));
     // Each side was built with its root at 0; here they follow their parent and each other.
@@ -45,7 +45,7 @@ fn build_serial(items: &mut [Item], offset: usize, nodes: &mut Vec<Node>, (b, c)
         return;
     }
     let me = nodes.len();
-    let (mid, lb, rb) = match split(items, &b, &c) {
+    let (mid, lb, rb) = match split(items, &c) {
         Some(sp) => (partition(items, &c, sp.axis, sp.bin), sp.left, sp.right),
         None if items.len() <= MAX_LEAF * 2 => {
             nodes.push(Node::leaf(&b, offset, items.len()));
@@ -92,9 +92,9 @@ fn bin(items: &[Item], c: &Aabb, axis: usize) -> Bins {
     )
 }
 
-/// The best binned-SAH split of `items` along the centres' longest axis, or `None` when a leaf
-/// is cheaper or the centres cannot be told apart.
-fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
+/// The best binned-SAH split of `items` along the centres' longest axis, or `None` when the
+/// centres cannot be told apart.
+fn split(items: &[Item], c: &Aabb) -> Option<Split> {
     let extent = c.max - c.min;
     // One axis only: a third of the binning work of trying all three; on the benchmark's HIGH
     // the whole bake took less CPU time this way (build cheaper, tracing no slower).
@@ -103,7 +103,7 @@ fn split(items: &[Item], b: &Aabb, c: &Aabb) -> Option<Split> {
     if e.is_nan() || e <= 0.0 {
         return None;
     }
-    choose(&bin(items, c, axis), items.len(), b, axis)
+    choose(&bin(items, c, axis), items.len(), axis)
 }
 
 /// Moves the items left of bin boundary `k` on `axis` to the front; returns how many there are.
@@ -122,8 +122,8 @@ fn partition(items: &mut [Item], c: &Aabb, axis: usize, k: usize) -> usize {
 
 /// Where `items` split and each side's bounds: by the best binned split, else in two halves of
 /// equal count (identical centres).
-fn divide(items: &mut [Item], b: &Aabb, c: &Aabb) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
-    match split(items, b, c) {
+fn divide(items: &mut [Item], c: &Aabb) -> (usize, (Aabb, Aabb), (Aabb, Aabb)) {
+    match split(items, c) {
         Some(sp) => (partition(items, c, sp.axis, sp.bin), sp.left, sp.right),
         None => halves(items),
     }

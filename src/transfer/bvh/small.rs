@@ -5,7 +5,7 @@
 //! gives. The items are one-byte indices into the range's boxes and centres (`range.rs`).
 
 use super::bounds::Aabb;
-use super::cost::{longest, MAX_LEAF, NODE_COST, SMALL};
+use super::cost::{longest, MAX_LEAF, SMALL};
 use super::local::Local;
 use super::node::Node;
 
@@ -19,8 +19,9 @@ pub(super) fn build(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<No
 /// The node over `idx`, sorted along axis `sorted` if some, with bounds `b`.
 fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb, sorted: Option<usize>) {
     let len = idx.len();
-    if len == 1 {
-        nodes.push(Node::leaf(&b, offset, l.weight[idx[0] as usize] as usize));
+    let weight: usize = idx.iter().map(|&i| l.weight[i as usize] as usize).sum();
+    if weight <= MAX_LEAF {
+        nodes.push(Node::leaf(&b, offset, weight));
         return;
     }
     let mut c = Aabb::EMPTY;
@@ -44,13 +45,6 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
     for t in 0..len {
         before[t + 1] = before[t] + l.weight[idx[t] as usize] as usize;
     }
-    let weight = before[len];
-    // Two triangles always make a leaf: splitting costs the node visit (`NODE_COST`, two
-    // triangle tests) on top of each side's one.
-    if weight == 2 && NODE_COST >= 2.0 {
-        nodes.push(Node::leaf(&b, offset, weight));
-        return;
-    }
     // Both sweeps in one loop, for two chains of joins the core runs side by side: `left[k]` and
     // `right[k]` are the boxes of the items before and from place `k`.
     let bounds = |k: usize| &l.bounds[idx[k] as usize];
@@ -72,12 +66,7 @@ fn node(l: &Local, idx: &mut [u8], offset: usize, nodes: &mut Vec<Node>, b: Aabb
             best = (cost, k);
         }
     }
-    let (cost, k) = best;
-    // As in `sah::split`: a node visit costs two triangle tests.
-    if weight <= MAX_LEAF && cost + NODE_COST * b.area() >= b.area() * weight as f32 {
-        nodes.push(Node::leaf(&b, offset, weight));
-        return;
-    }
+    let (_, k) = best;
     // No finite cost (boxes too large for f32 areas): halves.
     let k = if k == 0 { len / 2 } else { k };
     let (lb, rb) = (left[k], right[k]);
