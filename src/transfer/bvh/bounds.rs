@@ -34,7 +34,8 @@ impl Aabb {
     }
 }
 
-/// A triangle as the build sorts it: 28 bytes, its box and its index in the input. The centre
+/// A triangle (or a quad's two halves, `pairs.rs`) as the build sorts it: 28 bytes, its box and
+/// its index in the input (a pair's first triangle's). The centre
 /// is recomputed from the box, in the same arithmetic every time, rather than stored, so that
 /// the array the build moves around stays small.
 #[derive(Clone, Copy)]
@@ -67,9 +68,8 @@ pub(super) fn bounds_of(items: &[Item]) -> (Aabb, Aabb) {
     bounds_by(items.len(), |i| items[i])
 }
 
-/// [`bounds_of`] the `n` items `item` gives, made where they are needed rather than read from
-/// an array.
-pub(super) fn bounds_by(n: usize, item: impl Fn(usize) -> Item + Sync) -> (Aabb, Aabb) {
+/// [`bounds_of`] the `n` items `item` gives.
+fn bounds_by(n: usize, item: impl Fn(usize) -> Item + Sync) -> (Aabb, Aabb) {
     use rayon::prelude::*;
     let one = |r: std::ops::Range<usize>| {
         let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);

@@ -13,7 +13,7 @@ pub(super) const BINS: usize = 16;
 /// visit costed as two triangle tests), the build faster and the rays no slower
 /// (`docs/transfer.md`, "The tree build").
 pub(super) const MAX_LEAF: usize = 4;
-/// Ranges of at most this many triangles are split exactly, without bins (`small.rs`).
+/// Ranges of at most this many items are split exactly, without bins (`small.rs`).
 pub(super) const SMALL: usize = 16;
 
 /// Per bin: the items' bounds, their centres' bounds and their count (of triangles: an item

@@ -1,10 +1,11 @@
 //! A bounding-volume hierarchy over HIGH's triangles, four children to a node.
 //!
 //! Built in two steps: a binary tree by the surface area heuristic (`sah.rs`; ranges of up to
-//! 256 triangles in `range.rs` on the copies `local.rs` makes, of up to 16 in `small.rs`; the
-//! cost model and the choice of a boundary, shared by the three, in `cost.rs`), its upper levels
-//! split at Morton-code boundaries on a large HIGH (`morton.rs`), then collapsed to the four-wide
-//! nodes the rays walk (`collapse.rs`; both node layouts in `node.rs`).
+//! 256 items in `range.rs` on the copies `local.rs` makes, of up to 16 in `small.rs`; the bins,
+//! the cost of a boundary and its choice, shared by the three, in `cost.rs`), its upper levels
+//! split at Morton-code boundaries on a large HIGH (`morton.rs`, whose items are a triangle or a
+//! quad's two halves: `pairs.rs`), then collapsed to the four-wide nodes the rays walk
+//! (`collapse.rs`; both node layouts in `node.rs`).
 //!
 //! The tree depends on the triangles only, never on the thread count: every split is decided by
 //! the same binned sweep, and subtrees built on other threads are spliced in a fixed order.

@@ -1,4 +1,4 @@
-//! A range of at most `LOCAL` (256) triangles (every Morton range, and the bottom of every SAH
+//! A range of at most `LOCAL` (256) items (every Morton range, and the bottom of every SAH
 //! subtree), built on copies of its items' boxes and centres held by the builder: the splits move
 //! one-byte indices instead of 28-byte items, each centre is computed once instead of at every
 //! level, an item's bin is kept from the binning for the partition, and the partition moves its

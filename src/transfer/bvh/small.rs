@@ -1,4 +1,4 @@
-//! Ranges of at most [`SMALL`] triangles: the exact SAH split (each boundary between the centres
+//! Ranges of at most [`SMALL`] items: the exact SAH split (each boundary between the centres
 //! sorted along their longest axis) and no bins, whose fixed cost (16 bins, two sweeps) dwarfs
 //! the work on so few items. A node sorts its items only when its longest axis is not its
 //! parent's: a run of a sorted order is sorted, so the order is the one a sort at every node
