@@ -92,10 +92,10 @@ impl Hit {
 
 /// The watertight test; hits from both sides count, unless the ray takes front faces only.
 ///
-/// Corners are read by axis straight from `v` (`v[i][k]` is one load): a vector register indexed
+/// Corners are read by axis straight from `corners` (`corners[i][k]` is one load): a vector register indexed
 /// by a run-time axis goes through memory, and that store and reload cost more than the test.
 #[inline(always)]
-pub fn intersect(ray: &Ray, v: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
+pub fn intersect(ray: &Ray, corners: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
     let [kx, ky, kz] = ray.k;
     let [sx, sy, sz] = ray.shear;
     let [ox, oy, oz] = ray.o;
@@ -103,9 +103,9 @@ pub fn intersect(ray: &Ray, v: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
         let z = p[kz] - oz;
         (p[kx] - ox - sx * z, p[ky] - oy - sy * z, z)
     };
-    let (ax, ay, az) = sheared(&v[0]);
-    let (bx, by, bz) = sheared(&v[1]);
-    let (cx, cy, cz) = sheared(&v[2]);
+    let (ax, ay, az) = sheared(&corners[0]);
+    let (bx, by, bz) = sheared(&corners[1]);
+    let (cx, cy, cz) = sheared(&corners[2]);
     let mut u = cx * by - cy * bx;
     let mut v = ax * cy - ay * cx;
     let mut w = bx * ay - by * ax;
@@ -128,9 +128,32 @@ pub fn intersect(ray: &Ray, v: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> {
     if ray.front_only && det > 0.0 {
         return None;
     }
-    let t = (u * sz * az + v * sz * bz + w * sz * cz) / det;
+    let t = within_box(ray, corners, (u * sz * az + v * sz * bz + w * sz * cz) / det);
     let inv = 1.0 / det;
     Some((t, [u * inv, v * inv, w * inv]))
+}
+
+/// `t` moved into the part of the ray that the box of the triangle with corners `c` holds, as
+/// the tree's box test computes that part ([`hit_lanes`]: the same operations, the same margin).
+///
+/// On a sliver seen nearly edge on, `t` from the edge functions can be off by far more than
+/// the box test's margin (a thousandth, on a sliver a ten-thousandth wide): a hit would then
+/// lie nearer than its own box, and a box holding an equally near triangle of lower index (a
+/// duplicate) would be dropped as farther than the best hit. Inside its box, a hit is never
+/// nearer than the box of any node that holds it, so the tree finds what a test of every
+/// triangle finds. A hit already inside, as nearly every one is, keeps its `t`.
+#[inline(always)]
+fn within_box(ray: &Ray, c: &[[f32; 3]; 3], t: f32) -> f32 {
+    let [p, q, r] = c.map(Vec3A::from);
+    let t0 = (p.min(q).min(r) - ray.origin) * ray.inv;
+    let t1 = (p.max(q).max(r) - ray.origin) * ray.inv;
+    // An axis the ray has no part of: the box test asks only whether the origin is inside.
+    let flat = !ray.inv.is_finite_mask();
+    let near = Vec3A::select(flat, Vec3A::NEG_INFINITY, t0.min(t1)).max_element();
+    let far = Vec3A::select(flat, Vec3A::INFINITY, t0.max(t1)).min_element();
+    let near = near * (1.0 - BOX_MARGIN.copysign(near));
+    let far = far * (1.0 + BOX_MARGIN.copysign(far));
+    t.max(near).min(far)
 }
 
 /// A node or a leaf still to visit, and how far its part of the ray lies from the origin: one
