@@ -33,6 +33,7 @@ pub mod format;
 pub mod inspect;
 pub mod normalmap;
 pub mod output;
+pub(crate) mod pages;
 pub mod preview;
 pub mod progress;
 pub mod scene;

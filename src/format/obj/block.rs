@@ -172,8 +172,8 @@ impl Acc {
 }
 
 /// Appends to `out`, for each piece in order, `n` items: the piece's slice, then `fill` for the
-/// rest (`part` gives both). The copies run on every core, each straight into its place, so the
-/// output's first-touch page faults are spread over the cores too.
+/// rest (`part` gives both). The copies run on every core, each straight into its place, into
+/// pages made present first (`pages.rs`).
 fn append<T: Copy + Send + Sync>(
     out: &mut Vec<T>,
     pieces: &[Piece],
@@ -183,6 +183,7 @@ fn append<T: Copy + Send + Sync>(
     let total: usize = pieces.iter().map(|p| part(p).1).sum();
     out.reserve(total);
     let mut rest: &mut [MaybeUninit<T>] = &mut out.spare_capacity_mut()[..total];
+    crate::pages::prefault(rest);
     let mut slots = Vec::with_capacity(pieces.len());
     for p in pieces {
         let (slot, after) = std::mem::take(&mut rest).split_at_mut(part(p).1);

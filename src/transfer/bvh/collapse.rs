@@ -4,17 +4,6 @@
 use super::node::{Node, WideNode};
 use rayon::prelude::*;
 
-/// Collapses the binary tree `bin` (root at 0, each inner node's first child right after it)
-/// into four-wide nodes, root at 0, each node before its children (depth first).
-fn collapse_binary(bin: &[Node]) -> Vec<WideNode> {
-    if bin[0].is_leaf() {
-        return lone_leaf(&bin[0]);
-    }
-    let mut out = Vec::with_capacity(bin.len() / 3 + 1);
-    collapse_inner(bin, 0, &mut out);
-    out
-}
-
 /// A tree that is one leaf: a root with that leaf as its only child.
 fn lone_leaf(leaf: &Node) -> Vec<WideNode> {
     let mut w = WideNode::empty();
@@ -82,6 +71,13 @@ fn collapse_inner(bin: &[Node], b: usize, out: &mut Vec<WideNode>) -> u32 {
     me as u32
 }
 
+/// The most nodes a thread's collapse buffer keeps between ranges (a range's tree has fewer).
+const SCRATCH_KEPT: usize = 4096;
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Vec<WideNode>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
 /// The tree as the Morton build leaves it: binary splits over ranges, each range collapsed to
 /// its own four-wide tree on the core that built it, while its nodes are still in cache. A
 /// split carries its box in a [`Node`].
@@ -93,9 +89,30 @@ pub(super) enum Upper {
 }
 
 impl Upper {
-    /// A range over the binary tree `bin` (root at 0).
-    pub fn range(bin: Vec<Node>) -> Upper {
-        let wide = if bin[0].is_leaf() { Vec::new() } else { collapse_binary(&bin) };
+    /// A range over the binary tree `bin` (root at 0). Collapsed in a buffer each thread
+    /// reuses, then copied out at its size: tens of thousands of ranges at 10M triangles, and a
+    /// vector each grown to fit cost their allocations and copies.
+    pub fn range(bin: &[Node]) -> Upper {
+        if bin[0].is_leaf() {
+            return Upper::Range(bin[0], Vec::new());
+        }
+        let wide = if std::env::var_os("BB_OLD").is_some() {
+            let mut o = Vec::new();
+            collapse_inner(bin, 0, &mut o);
+            o
+        } else {
+            SCRATCH.with(|s| {
+                let mut s = s.borrow_mut();
+                s.clear();
+                collapse_inner(bin, 0, &mut s);
+                let wide = s.to_vec();
+                // A whole tree built without ranges (a small HIGH) is not held on to.
+                if s.capacity() > SCRATCH_KEPT {
+                    *s = Vec::new();
+                }
+                wide
+            })
+        };
         Upper::Range(bin[0], wide)
     }
 
@@ -118,7 +135,7 @@ impl Upper {
         let (mut out, mut later) = (Vec::new(), Vec::new());
         collapse_split(&self, &mut out, &mut later);
         // Each range's tree goes after the upper nodes, in the order the splits met them; the
-        // copies (tens of MB at 10M triangles, every page of them new) run on every core.
+        // copies (tens of MB at 10M triangles, into new pages) run on every core.
         let base = out.len();
         let mut starts = Vec::with_capacity(later.len() + 1);
         starts.push(0);
@@ -129,6 +146,7 @@ impl Upper {
         }
         let total = *starts.last().expect("starts at 0");
         out.reserve_exact(total);
+        crate::pages::prefault(out.spare_capacity_mut());
         // Each task walks its indices upwards, so the range holding index `i` is found by one
         // search per task and then by stepping on.
         out.par_extend((0..total).into_par_iter().map_init(

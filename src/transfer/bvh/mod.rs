@@ -87,7 +87,7 @@ impl Bvh {
         }
         let mut items: Vec<Item> = (0..n).into_par_iter().map(item).collect();
         let bc = bounds_of(&items);
-        let upper = Upper::range(sah::build_par(&mut items, 0, bc));
+        let upper = Upper::range(&sah::build_par(&mut items, 0, bc));
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         // Each array is dropped as soon as the next is made from it: the build's peak is what
         // bounds memory on a large HIGH.

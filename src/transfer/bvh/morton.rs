@@ -54,6 +54,8 @@ where
     drop(found.ids);
     let starts = triangle_starts(&keys, &pairs);
     let (mut tris, mut ids): (Vec<Tri>, Vec<u32>) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    crate::pages::prefault(tris.spare_capacity_mut());
+    crate::pages::prefault(ids.spare_capacity_mut());
     let out = Out { tris: &mut tris.spare_capacity_mut()[..n], ids: &mut ids.spare_capacity_mut()[..n] };
     let upper = build_upper(&Mesh { item, tri, pairs: &pairs }, &mut keys, &starts, out);
     // SAFETY: the ranges split the keys without gaps, the slots in step with their triangles,
@@ -132,6 +134,7 @@ fn morton_keys(ids: &[u32], centre: impl Fn(u32) -> Vec3A + Sync, c: &Aabb) -> V
         })
         .collect();
     let mut sorted = vec![0u64; n];
+    crate::pages::prefault(&mut sorted);
     let mut shares: Vec<Vec<&mut [u64]>> = counts.iter().map(|_| Vec::with_capacity(BUCKETS)).collect();
     let mut sizes = [0usize; BUCKETS];
     let mut rest = sorted.as_mut_slice();
@@ -222,7 +225,7 @@ where
     let code = |k: u64| k >> INDEX_BITS;
     let (first, last) = (code(keys[0]), code(keys[keys.len() - 1]));
     if keys.len() <= SAH_RANGE || first == last {
-        return Upper::range(range(mesh, keys, starts[0] as usize, out));
+        return range(mesh, keys, starts[0] as usize, out);
     }
     let bit = 63 - (first ^ last).leading_zeros();
     let mid = keys.partition_point(|&k| code(k) >> bit & 1 == 0);
@@ -239,9 +242,14 @@ where
     Upper::Split(Node::inner(&b, 0), Box::new(left), Box::new(right))
 }
 
-/// The binary tree over the range of items `keys` names, their triangles starting at `offset`
-/// in leaf order; writes every slot of `out`.
-fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], offset: usize, out: Out) -> Vec<Node>
+thread_local! {
+    /// A range's binary tree, in a buffer each thread reuses: only its four-wide tree is kept.
+    static BIN: std::cell::RefCell<Vec<Node>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// The tree over the range of items `keys` names, their triangles starting at `offset` in leaf
+/// order; writes every slot of `out`.
+fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], offset: usize, out: Out) -> Upper
 where
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
@@ -249,11 +257,14 @@ where
     keys.iter_mut().for_each(|k| *k &= INDEX_MASK);
     let triangles = |k: &u64| (*k as u32..).take(mesh.pairs.size(*k as u32) as usize);
     if keys.len() <= LOCAL {
-        let mut nodes = Vec::with_capacity(keys.len() / 2 + 1);
         let item = |t: usize| (mesh.pairs.item(t as u32, mesh.item), mesh.pairs.size(t as u32) as u8);
-        range::build_by_index(item, keys, offset, &mut nodes);
-        write(mesh, out, keys.iter().flat_map(triangles));
-        return nodes;
+        return BIN.with(|b| {
+            let mut nodes = b.borrow_mut();
+            nodes.clear();
+            range::build_by_index(item, keys, offset, &mut nodes);
+            write(mesh, out, keys.iter().flat_map(triangles));
+            Upper::range(&nodes)
+        });
     }
     // Many items with one code (a pile of duplicates): their triangles gathered one by one, then
     // split by count.
@@ -261,7 +272,7 @@ where
     let bc = bounds_of(&gathered);
     let nodes = sah::build_par(&mut gathered, offset, bc);
     write(mesh, out, gathered.iter().map(|it| it.id));
-    nodes
+    Upper::range(&nodes)
 }
 
 /// Writes the triangles `ids` (as many as `out` has slots) and their ids into `out`: the range's
