@@ -96,23 +96,17 @@ impl Upper {
         if bin[0].is_leaf() {
             return Upper::Range(bin[0], Vec::new());
         }
-        let wide = if std::env::var_os("BB_OLD").is_some() {
-            let mut o = Vec::new();
-            collapse_inner(bin, 0, &mut o);
-            o
-        } else {
-            SCRATCH.with(|s| {
-                let mut s = s.borrow_mut();
-                s.clear();
-                collapse_inner(bin, 0, &mut s);
-                let wide = s.to_vec();
-                // A whole tree built without ranges (a small HIGH) is not held on to.
-                if s.capacity() > SCRATCH_KEPT {
-                    *s = Vec::new();
-                }
-                wide
-            })
-        };
+        let wide = SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            s.clear();
+            collapse_inner(bin, 0, &mut s);
+            let wide = s.to_vec();
+            // A whole tree built without ranges (a small HIGH) is not held on to.
+            if s.capacity() > SCRATCH_KEPT {
+                *s = Vec::new();
+            }
+            wide
+        });
         Upper::Range(bin[0], wide)
     }
 
