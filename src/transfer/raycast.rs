@@ -144,7 +144,7 @@ pub fn intersect(ray: &Ray, corners: &[[f32; 3]; 3]) -> Option<(f32, [f32; 3])> 
 /// triangle finds. A hit already inside, as nearly every one is, keeps its `t`.
 #[inline(always)]
 fn within_box(ray: &Ray, c: &[[f32; 3]; 3], t: f32) -> f32 {
-    let [p, q, r] = c.map(Vec3A::from);
+    let (p, q, r) = (Vec3A::from(c[0]), Vec3A::from(c[1]), Vec3A::from(c[2]));
     let t0 = (p.min(q).min(r) - ray.origin) * ray.inv;
     let t1 = (p.max(q).max(r) - ray.origin) * ray.inv;
     // An axis the ray has no part of: the box test asks only whether the origin is inside.

@@ -72,11 +72,15 @@ impl Bvh {
         if n == 0 {
             return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
         }
-        let corners = |i: usize| triangles[i].map(|k| positions[k as usize]);
+        // Spelled out, not `t.map(..)`: the array's `map` was left out of line here, built the
+        // corners on the stack and read them back whole before their stores had landed, and
+        // cost the build a tenth of its time (`docs/transfer-history.md`).
+        let at = |t: [u32; 3]| [positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]];
+        let corners = |i: usize| at(triangles[i]);
         let item = |i: usize| Item::of(&corners(i), i as u32);
         let tri = |i: u32| {
             let t = triangles[i as usize];
-            Tri { corners: t.map(|k| positions[k as usize]), index: index(i).unwrap_or(t) }
+            Tri { corners: at(t), index: index(i).unwrap_or(t) }
         };
         if morton::applies(n) {
             // Each range writes its triangles in leaf order as it ends, while they are cached:
