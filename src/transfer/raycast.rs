@@ -59,7 +59,7 @@ impl Ray {
     /// overflows counts as none, since the ray then stays in the slab it starts in (or out of
     /// it) however far it goes. The box test needs a case of its own for such an axis.
     fn flat_axes(&self) -> [bool; 3] {
-        self.inv.to_array().map(|x| x.is_infinite())
+        [self.inv.x.is_infinite(), self.inv.y.is_infinite(), self.inv.z.is_infinite()]
     }
 
     /// Whether the ray has a part of every axis (nearly every ray has; see `flat_axes`).

@@ -99,9 +99,12 @@ pub(super) fn find(n: usize, corners: impl Fn(usize) -> [[f32; 3]; 3] + Sync) ->
 /// Whether two of `b`'s corners are at positions of `a`'s (bit for bit: the corners a mesh
 /// shares, whether through one index or two).
 fn shares_edge(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
-    let bits = |p: &[f32; 3]| p.map(f32::to_bits);
-    let a = a.map(|p| bits(&p));
-    b.iter().filter(|p| a.contains(&bits(p))).count() >= 2
+    // Spelled out rather than through arrays' `map`, which is left out of line here (see
+    // `Bvh::build_indexed`).
+    let bits = |p: &[f32; 3]| [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+    let a = [bits(&a[0]), bits(&a[1]), bits(&a[2])];
+    let shared = |p: &[f32; 3]| a.contains(&bits(p)) as u32;
+    shared(&b[0]) + shared(&b[1]) + shared(&b[2]) >= 2
 }
 
 #[cfg(test)]
