@@ -85,7 +85,7 @@ impl Bvh {
         if morton::applies(n) {
             // Each range writes its triangles in leaf order as it ends, while they are cached:
             // no array of items, no pass of its own over HIGH in leaf order.
-            let (upper, ids, tris) = morton::build(n, &corners, &item, &tri);
+            let (upper, ids, tris) = morton::build(n, &corners, &tri);
             drop(triangles);
             return Bvh { nodes: upper.collapse(), ids, tris };
         }

@@ -37,17 +37,17 @@ pub(super) fn applies(n: usize) -> bool {
     (MORTON_MIN..1 << INDEX_BITS).contains(&n)
 }
 
-/// Builds the tree over the `n` triangles whose corners `corners` gives and whose boxes `item`
-/// gives, its items in the order of the Morton codes of their centres; returns it, the
+/// Builds the tree over the `n` triangles whose corners `corners` gives, its items in the
+/// order of the Morton codes of their centres; returns it, the
 /// triangles' ids in leaf order and `tri` of each id in that order. The items are never
 /// gathered into that order: each range computes its own from the mesh, and writes its
 /// triangles in leaf order into their place.
-pub(super) fn build<C, I, T>(n: usize, corners: &C, item: &I, tri: &T) -> (Upper, Vec<u32>, Vec<Tri>)
+pub(super) fn build<C, T>(n: usize, corners: &C, tri: &T) -> (Upper, Vec<u32>, Vec<Tri>)
 where
     C: Fn(usize) -> [[f32; 3]; 3] + Sync,
-    I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
 {
+    let item = |i: usize| Item::of(&corners(i), i as u32);
     let found = pairs::find(n, corners);
     let pairs = found.pairs;
     let mut keys = morton_keys(&found.ids, |t| pairs.item(t, item).centre(), &found.centres);
@@ -57,7 +57,7 @@ where
     crate::pages::prefault(tris.spare_capacity_mut());
     crate::pages::prefault(ids.spare_capacity_mut());
     let out = Out { tris: &mut tris.spare_capacity_mut()[..n], ids: &mut ids.spare_capacity_mut()[..n] };
-    let upper = build_upper(&Mesh { item, tri, pairs: &pairs }, &mut keys, &starts, out);
+    let upper = build_upper(&Mesh { item: &item, tri, pairs: &pairs }, &mut keys, &starts, out);
     // SAFETY: the ranges split the keys without gaps, the slots in step with their triangles,
     // and each range writes every slot of its own (`range`), so all `n` are written.
     unsafe {
