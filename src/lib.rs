@@ -36,6 +36,7 @@ pub mod output;
 pub(crate) mod pages;
 pub mod preview;
 pub mod progress;
+pub(crate) mod scan;
 pub mod scene;
 pub mod tangent;
 pub mod textures;

@@ -181,7 +181,7 @@ fn the_library_reads_no_environment() {
 /// The layer of a top-level module of the library (the first part of its path).
 fn layer(module: &str) -> Option<u8> {
     Some(match module {
-        "error" | "progress" | "output" | "timings" | "batch" | "pages" => 0,
+        "error" | "progress" | "output" | "timings" | "batch" | "pages" | "scan" => 0,
         "scene" => 1,
         "format" => 2,
         "tangent" | "normalmap" => 3,

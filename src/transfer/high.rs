@@ -88,7 +88,7 @@ fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<HighMesh>
         } else if own.is_empty() {
             Some(triangles.to_vec())
         } else {
-            (!own.par_iter().any(|c| c.contains(&MISSING))).then_some(own)
+            (!crate::scan::any(&own, |c| c.contains(&MISSING))).then_some(own)
         }
     };
     let normal_triangles = indices(m.normal_triangles, m.normals.len(), &m.triangles);

@@ -14,6 +14,7 @@ use crate::scene::nodes::{instances, Instance, Placement};
 use crate::scene::to_triangle_list;
 use crate::scene::{smooth_vertex_normals, PrimRef, PrimView, ReadOptions, Scene};
 use glam::{DVec3, Mat4, Vec3, Vec3A};
+use rayon::prelude::*;
 use std::path::Path;
 
 /// LOW after tangents: per-vertex streams of every baked primitive, appended.
@@ -70,8 +71,9 @@ impl High {
                 normal_triangles.extend(shifted.iter().map(|t| t.map(|i| i + b)));
             }
         }
-        let shared = normal_triangles == triangles;
-        positions.iter_mut().for_each(|p| *p = local(dvec(*p), origin).to_array());
+        let shared = normal_triangles.len() == triangles.len()
+            && normal_triangles.par_chunks(1 << 14).zip(triangles.par_chunks(1 << 14)).all(|(a, b)| a == b);
+        positions.par_iter_mut().for_each(|p| *p = local(dvec(*p), origin).to_array());
         let (base_p, base_n) = (self.positions.len() as u32, self.normals.len() as u32);
         if shared && self.normal_triangles.is_none() && base_p == base_n {
             drop(normal_triangles);

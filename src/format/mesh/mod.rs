@@ -99,7 +99,7 @@ pub fn v_down(uvs: &mut [[f32; 2]]) {
 /// The first vertex with a coordinate that is not finite, as an error naming `path` (every
 /// reader's words for it); on every core.
 pub fn check_finite(path: &Path, p: &[[f32; 3]]) -> Result<()> {
-    match p.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
+    match crate::scan::first(p, |q| !q.iter().all(|c| c.is_finite())) {
         Some(i) => Err(Error::input(path, format!("vertex {} has a non-finite coordinate", i + 1))),
         None => Ok(()),
     }
@@ -107,7 +107,7 @@ pub fn check_finite(path: &Path, p: &[[f32; 3]]) -> Result<()> {
 
 /// [`check_finite`] for texture coordinates.
 pub fn check_finite_uv(path: &Path, uv: &[[f32; 2]]) -> Result<()> {
-    match uv.par_iter().position_first(|q| !q.iter().all(|c| c.is_finite())) {
+    match crate::scan::first(uv, |q| !q.iter().all(|c| c.is_finite())) {
         Some(i) => Err(Error::input(path, format!("texture coordinate {} is not finite", i + 1))),
         None => Ok(()),
     }

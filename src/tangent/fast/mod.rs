@@ -86,7 +86,7 @@ pub fn generate_timed(mesh: &TriMesh, timings: &mut crate::timings::Timings) -> 
         return Err(Unsupported::TooLarge);
     }
     let limit = mesh.positions.len().min(mesh.normals.len()).min(mesh.uvs.len());
-    if mesh.indices[..3 * n_faces].par_iter().any(|&i| i as usize >= limit) {
+    if crate::scan::any(&mesh.indices[..3 * n_faces], |&i| i as usize >= limit) {
         return Err(Unsupported::IndexOutOfRange);
     }
     let c = Corners { mesh };
