@@ -94,10 +94,17 @@ pub(super) fn encode(
         files.push((p.clone(), bytes));
     }
     // One pass in texel order, without a copy of the heights (a zero's sign is kept as found).
-    let range = texels.iter().filter(|x| x.hits > 0).fold(None, |r: Option<[f32; 2]>, x| {
-        let [lo, hi] = r.unwrap_or([f32::INFINITY, f32::NEG_INFINITY]);
-        Some([lo.min(x.height), hi.max(x.height)])
-    });
+    // Blocks of a fixed size, joined in order: the same range on any thread count.
+    let join = |r: Option<[f32; 2]>, x: Option<[f32; 2]>| match (r, x) {
+        (Some([a, b]), Some([c, d])) => Some([a.min(c), b.max(d)]),
+        (r, x) => r.or(x),
+    };
+    let range = texels
+        .par_chunks(1 << 16)
+        .map(|c| c.iter().filter(|x| x.hits > 0).map(|x| Some([x.height; 2])).fold(None, join))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold(None, join);
     if let Some(p) = &s.height_out {
         let [lo, hi] = range.unwrap_or([0.0, 0.0]);
         let span = if hi > lo { hi - lo } else { 1.0 };
