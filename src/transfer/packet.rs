@@ -109,7 +109,7 @@ mod wide {
                         test_leaf(bvh, &p.rays[i].0, k, &mut p.lo[i], &mut p.hi[i], &mut out[i]);
                     }
                 }
-            } else if let Some(next) = node(&p, &bvh.nodes[todo.child as usize], todo.rays, stack) {
+            } else if let Some(next) = node(bvh, &p, &bvh.nodes[todo.child as usize], todo.rays, stack) {
                 todo = next;
                 continue;
             }
@@ -156,7 +156,7 @@ mod wide {
     /// child's distance is the least of the rays' that meet it.
     #[inline]
     #[target_feature(enable = "avx")]
-    fn node(p: &Rays, n: &WideNode, rays: u32, stack: &mut Vec<Entry>) -> Option<Entry> {
+    fn node(bvh: &Bvh, p: &Rays, n: &WideNode, rays: u32, stack: &mut Vec<Entry>) -> Option<Entry> {
         let m = _mm256_set1_ps(BOX_MARGIN);
         let one = _mm256_set1_ps(1.0);
         // SAFETY: eight floats each from `8 * h`.
@@ -198,6 +198,7 @@ mod wide {
             }
             if k.rays != 0 {
                 (k.child, k.count) = (n.child[lane], n.count[lane] as u32);
+                bvh.prefetch(k.child, k.count);
                 mask |= 1 << lane;
             }
         }
