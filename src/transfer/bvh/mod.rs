@@ -28,9 +28,6 @@ use bounds::{bounds_of, Item};
 use collapse::Upper;
 pub use node::WideNode;
 
-/// The most bytes [`Bvh::prefetch`] asks for at once (four cache lines).
-const PREFETCH_MAX: usize = 256;
-
 /// Ranges smaller than this are built, bounded and binned on the current thread.
 const PARALLEL_MIN: usize = 16 * 1024;
 
@@ -128,26 +125,13 @@ impl Bvh {
     /// here and no result depends on it.
     #[inline(always)]
     pub fn prefetch(&self, child: u32, count: u32) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let lines = |start: *const u8, bytes: usize| {
-                for off in (0..bytes.min(PREFETCH_MAX)).step_by(64) {
-                    // SAFETY: a prefetch is a hint; it reads nothing and cannot fault, and the
-                    // address stays inside the array (`wrapping_add` within its bytes).
-                    unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(off).cast()) };
-                }
-            };
-            if count > 0 {
-                if let Some(t) = self.tris.get(child as usize..(child + count) as usize) {
-                    lines(t.as_ptr().cast(), std::mem::size_of_val(t));
-                }
-            } else if let Some(n) = self.nodes.get(child as usize) {
-                lines((n as *const WideNode).cast(), std::mem::size_of::<WideNode>());
-            }
+        use crate::pages::prefetch;
+        let at = child as usize;
+        if count > 0 {
+            prefetch(self.tris.get(at..at + count as usize).unwrap_or(&[]));
+        } else {
+            prefetch(self.nodes.get(at..at + 1).unwrap_or(&[]));
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = (child, count);
     }
 
     /// Bytes held, for the memory figures.
