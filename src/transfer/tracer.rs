@@ -95,7 +95,8 @@ enum Prep {
 /// are traced together once [`packet::PACKET`] of them into one tree are queued.
 #[derive(Default)]
 struct Queue {
-    samples: Vec<(usize, Prep)>,
+    /// Each sample's index in the band, its texel's, and what it waits with.
+    samples: Vec<(usize, usize, Prep)>,
     /// The queued samples' rays, with their reach behind and ahead.
     rays: Vec<(raycast::Ray, f32, f32)>,
     /// Which of HIGH's trees they go into.
@@ -113,12 +114,12 @@ impl Queue {
         matches!(prep, Prep::Trace(p) if full || (!self.rays.is_empty() && p.set != self.set))
     }
 
-    fn push(&mut self, s: usize, prep: Prep) {
+    fn push(&mut self, s: usize, texel: usize, prep: Prep) {
         if let Prep::Trace(p) = &prep {
             self.rays.push((p.ray, p.back, p.front));
             self.set = p.set;
         }
-        self.samples.push((s, prep));
+        self.samples.push((s, texel, prep));
     }
 
     /// Traces the queued rays into `hits`.
@@ -200,32 +201,19 @@ impl Tracer<'_> {
         let samples = raster::band(edges, cand, y0, y1, w, n);
         c.overlapping_samples = samples.overlapping;
         let sw = w * n;
-        // Blocks of BLOCK x BLOCK texels, one after another, down the band and then across it:
-        // a packet's rays come from one block, whose rays meet nearly the same nodes, and the
-        // next blocks' rays meet the same part of HIGH's tree while it is still in cache. Each
-        // texel's samples lie in one block and keep their order (rows, then columns), so the
-        // sums are the same as row by row.
         let rows = samples.owner.len() / sw;
-        let order = (0..w.div_ceil(BLOCK)).flat_map(move |bx| {
-            let (a, b) = (bx * BLOCK * n, ((bx + 1) * BLOCK).min(w) * n);
-            (0..rows.div_ceil(BLOCK * n)).flat_map(move |by| {
-                let (c, d) = (by * BLOCK * n, ((by + 1) * BLOCK * n).min(rows));
-                (c..d).flat_map(move |sy| (a..b).map(move |sx| sy * sw + sx))
-            })
-        });
         let mut queue = Queue::default();
         // Traces the queued samples' rays and sums what each sample gave into its texel, in the
         // samples' order.
         let mut record = |queue: &mut Queue, c: &mut Counts| {
             queue.trace(self.trees);
             let mut hits = queue.hits.iter();
-            for (s, prep) in queue.samples.drain(..) {
+            for (s, texel, prep) in queue.samples.drain(..) {
                 let t = samples.owner[s];
                 let r = match prep {
                     Prep::Done(r) => r,
                     Prep::Trace(p) => self.finish(&p, *hits.next().expect("a hit a ray"), c),
                 };
-                let texel = (s / sw / n) * w + (s % sw) / n;
                 let part = self.low.tri_part[t as usize];
                 let ps = &mut parts[part as usize];
                 ps.rays += 1;
@@ -251,19 +239,31 @@ impl Tracer<'_> {
             }
             queue.rays.clear();
         };
-        for s in order {
-            let t = samples.owner[s];
-            if t == u32::MAX {
-                continue;
+        // Blocks of BLOCK x BLOCK texels, one after another, down the band and then across it:
+        // a packet's rays come from one block, whose rays meet nearly the same nodes, and the
+        // next blocks' rays meet the same part of HIGH's tree while it is still in cache. Each
+        // texel's samples lie in one block and keep their order (rows, then columns), so the
+        // sums are the same as row by row.
+        for bx in 0..w.div_ceil(BLOCK) {
+            let columns = bx * BLOCK * n..((bx + 1) * BLOCK).min(w) * n;
+            for by in 0..rows.div_ceil(BLOCK * n) {
+                for sy in by * BLOCK * n..((by + 1) * BLOCK * n).min(rows) {
+                    for sx in columns.clone() {
+                        let s = sy * sw + sx;
+                        let t = samples.owner[s];
+                        if t == u32::MAX {
+                            continue;
+                        }
+                        let (x, y) = raster::sample_pos(sx, sy, y0, n);
+                        let e = edges[t as usize].as_ref().expect("owners have edges");
+                        let prep = self.prepare(t as usize, e.bary(x, y), &mut c);
+                        if queue.full_for(&prep) {
+                            record(&mut queue, &mut c);
+                        }
+                        queue.push(s, (sy / n) * w + sx / n, prep);
+                    }
+                }
             }
-            let (sx, sy) = (s % sw, s / sw);
-            let (x, y) = raster::sample_pos(sx, sy, y0, n);
-            let e = edges[t as usize].as_ref().expect("owners have edges");
-            let prep = self.prepare(t as usize, e.bary(x, y), &mut c);
-            if queue.full_for(&prep) {
-                record(&mut queue, &mut c);
-            }
-            queue.push(s, prep);
         }
         record(&mut queue, &mut c);
         // The band's texels are counted here, on the core that traced them.
