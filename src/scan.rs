@@ -19,12 +19,18 @@ pub fn any<T: Sync>(v: &[T], bad: impl Fn(&T) -> bool + Sync) -> bool {
     v.par_chunks(BLOCK).any(|c| c.iter().any(&bad))
 }
 
+/// Whether `a` and `b` hold the same items, compared on every core.
+pub fn same<T: PartialEq + Sync>(a: &[T], b: &[T]) -> bool {
+    a.len() == b.len() && a.par_chunks(BLOCK).zip(b.par_chunks(BLOCK)).all(|(x, y)| x == y)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn first_finds_the_first_match_across_blocks() {
+        assert!(!same(&[0u32; 3], &[0u32; 2]));
         let mut v = vec![0u32; 3 * BLOCK + 7];
         assert_eq!(first(&v, |&x| x > 0), None);
         assert!(!any(&v, |&x| x > 0));
@@ -35,6 +41,7 @@ mod tests {
             v[last] = 1;
             assert_eq!(first(&v, |&x| x > 0), Some(at));
             assert!(any(&v, |&x| x > 0));
+            assert!(!same(&v, &vec![0u32; v.len()]) && same(&v, &v.clone()));
             v.iter_mut().for_each(|x| *x = 0);
         }
     }

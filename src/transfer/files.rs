@@ -93,8 +93,8 @@ pub(super) fn encode(
                 .map_err(|e| Error::output(p, e))?;
         files.push((p.clone(), bytes));
     }
-    // One pass in texel order, without a copy of the heights (a zero's sign is kept as found).
-    // Blocks of a fixed size, joined in order: the same range on any thread count.
+    // On every core, without a copy of the heights: blocks of a fixed size, joined in order, so
+    // the range is the same on any thread count.
     let join = |r: Option<[f32; 2]>, x: Option<[f32; 2]>| match (r, x) {
         (Some([a, b]), Some([c, d])) => Some([a.min(c), b.max(d)]),
         (r, x) => r.or(x),

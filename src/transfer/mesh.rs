@@ -71,8 +71,7 @@ impl High {
                 normal_triangles.extend(shifted.iter().map(|t| t.map(|i| i + b)));
             }
         }
-        let shared = normal_triangles.len() == triangles.len()
-            && normal_triangles.par_chunks(1 << 14).zip(triangles.par_chunks(1 << 14)).all(|(a, b)| a == b);
+        let shared = crate::scan::same(&normal_triangles, &triangles);
         positions.par_iter_mut().for_each(|p| *p = local(dvec(*p), origin).to_array());
         let (base_p, base_n) = (self.positions.len() as u32, self.normals.len() as u32);
         if shared && self.normal_triangles.is_none() && base_p == base_n {
