@@ -16,7 +16,6 @@ use crate::error::{Error, Result};
 use crate::format::mesh::{StoredMesh, MISSING};
 use crate::progress::Reporter;
 use rayon::prelude::*;
-use std::borrow::Cow;
 use std::mem::MaybeUninit;
 use std::path::Path;
 
@@ -50,15 +49,16 @@ impl Acc {
     }
 
     fn parse_and_place<const FAST: bool>(&mut self, path: &Path, texts: &[&[u8]], pieces: &mut [Piece]) -> Result<()> {
-        // A piece holding a continued line is read joined; each piece is looked through for one
-        // on the core that parses it, just before, while its text is in that core's cache.
+        // A piece holding a continued line is read again, joined: the parse stops at the first
+        // such line, so no pass over the text looks for one first.
         let mut joined: Vec<Option<Vec<u8>>> = vec![None; texts.len()];
         pieces.par_iter_mut().zip(texts).zip(&mut joined).for_each(|((p, t), j)| {
-            if let Cow::Owned(v) = join(t) {
+            p.parse::<FAST>(t, None);
+            if p.continued {
+                let v = join(t).into_owned();
+                p.parse::<FAST>(&v, None);
                 *j = Some(v);
             }
-            let t = j.as_deref().unwrap_or(t);
-            p.parse::<FAST>(t, None);
             self.progress.tick(t.len() as u64);
         });
         let texts: Vec<&[u8]> = texts.iter().zip(&joined).map(|(&t, j)| j.as_deref().unwrap_or(t)).collect();

@@ -16,7 +16,7 @@ fn continued_to(bytes: &[u8], at: usize) -> Option<usize> {
 }
 
 /// Whether the line end at `nl` continues its line.
-fn continues(bytes: &[u8], nl: usize) -> bool {
+pub(super) fn continues(bytes: &[u8], nl: usize) -> bool {
     let before = &bytes[..nl];
     match before.iter().rposition(|&c| c == b'\n' || c > b' ') {
         Some(k) => before[k] == b'\\',
@@ -52,7 +52,7 @@ pub(super) fn next_line_end(bytes: &[u8], from: usize) -> Option<usize> {
 /// `bytes` with each continuation joined: the `\`, the whitespace after it and its line end
 /// become spaces, and the line ends taken out follow the joined line's own, so the text keeps
 /// its length and every line after it its number (an error in a joined line names its first).
-/// Borrowed when there is nothing to join, the common case, found by `memchr`.
+/// Borrowed when there is nothing to join.
 pub(super) fn join(bytes: &[u8]) -> Cow<'_, [u8]> {
     if !memchr_iter(b'\\', bytes).any(|at| continued_to(bytes, at).is_some()) {
         return Cow::Borrowed(bytes);

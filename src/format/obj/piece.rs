@@ -1,6 +1,7 @@
 //! One piece of an OBJ block (about a megabyte of whole lines), parsed into arrays of its own:
 //! the line reader, with the common lines' own path (`fast.rs`) tried first.
 
+use super::continuation::continues;
 use super::fast::{fast_corners, fast_floats, Corner};
 use crate::format::mesh::text_number::{is_space, parse_f32, short_int};
 use crate::format::mesh::{Statement, MISSING};
@@ -103,6 +104,9 @@ pub(super) struct Piece {
     pub counts: Counts,
     /// Parsed without its base, it stopped at a relative index: it must be parsed again.
     pub needs_base: bool,
+    /// It stopped at a line continued by a `\\` (`continuation.rs`): it must be parsed again,
+    /// joined.
+    pub continued: bool,
     /// The first error, at the piece's own line number.
     pub error: Option<(u64, String)>,
 }
@@ -196,6 +200,12 @@ impl Piece {
                 }
             }
             let end = line_end(b, i);
+            // Only here, before the line is read: a continued line never takes the common
+            // path, whose lines end in a number or an index.
+            if end < b.len() && continues(b, end) {
+                self.continued = true;
+                return;
+            }
             let (kind, after) = keyword(b, i);
             let mut l = Line { b: &b[..end], i: after };
             let r: std::result::Result<(), Stop> = match kind {
@@ -271,7 +281,7 @@ impl Piece {
         self.mtllibs.clear();
         self.forward.clear();
         (self.any_t, self.any_n, self.max, self.counts) = (false, false, [0; 3], Counts::default());
-        (self.needs_base, self.error) = (false, None);
+        (self.needs_base, self.continued, self.error) = (false, false, None);
     }
 
     /// The line at `i` if it is a common one, parsed; where the next line starts. `None` (nothing
