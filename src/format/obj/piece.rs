@@ -104,7 +104,7 @@ pub(super) struct Piece {
     pub counts: Counts,
     /// Parsed without its base, it stopped at a relative index: it must be parsed again.
     pub needs_base: bool,
-    /// It stopped at a line continued by a `\\` (`continuation.rs`): it must be parsed again,
+    /// It stopped at a line continued by a `\` (`continuation.rs`): it must be parsed again,
     /// joined.
     pub continued: bool,
     /// The first error, at the piece's own line number.
