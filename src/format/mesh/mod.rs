@@ -1,10 +1,13 @@
 //! What the OBJ and PLY readers share: the mesh as either file stores it ([`StoredMesh`]: values
 //! in the file's own conventions, UVs v up, each attribute with its own index stream or, as PLY
-//! stores them, one value per position), the numbers of their text (`text_number.rs`) and the
+//! stores them, one value per position), the numbers of their text (`text_number.rs`, the
+//! common plain decimal in one vector: `decimal16.rs`) and the
 //! corners made a glTF primitive (`to_gltf.rs`). The Scene builders (`obj/`, `ply/scene.rs`) and
 //! HIGH's reader (`transfer/high.rs`) take a `StoredMesh` from there, and turn v down through
 //! [`v_down`], the one flip.
 
+#[cfg(target_arch = "x86_64")]
+mod decimal16;
 pub(super) mod text_number;
 pub(super) mod to_gltf;
 

@@ -80,6 +80,13 @@ pub fn parse_f32(t: &[u8]) -> Option<f32> {
 /// the first blank or newline (`None` when that token is not a number).
 #[inline]
 pub fn lead_f32(t: &[u8]) -> Option<(f32, usize)> {
+    #[cfg(target_arch = "x86_64")]
+    if super::decimal16::available() {
+        // SAFETY: the CPU has what `read` uses, just checked.
+        if let Some(r) = unsafe { super::decimal16::read(t) } {
+            return Some(r);
+        }
+    }
     let ends = |c: u8| is_space(c) || c == b'\n';
     let slow = || {
         let e = t.iter().position(|&c| ends(c)).unwrap_or(t.len());
