@@ -16,7 +16,7 @@ use std::arch::x86_64::*;
 
 /// Whether this CPU has the instructions [`read`] uses (every x86-64 CPU since about 2008).
 #[inline]
-pub(super) fn available() -> bool {
+pub(in crate::format) fn available() -> bool {
     std::arch::is_x86_feature_detected!("sse4.1")
 }
 

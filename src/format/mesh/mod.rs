@@ -7,7 +7,7 @@
 //! [`v_down`], the one flip.
 
 #[cfg(target_arch = "x86_64")]
-mod decimal16;
+pub(super) mod decimal16;
 pub(super) mod text_number;
 pub(super) mod to_gltf;
 

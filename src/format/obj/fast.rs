@@ -11,7 +11,7 @@ pub(super) type Corner = [u32; 3];
 /// `N` numbers from `i` on, each after one or more blanks, then the line's end (blanks and a
 /// `\r` allowed before it); the numbers and where the next line starts. `None` for anything else
 /// (a comment, a fourth number, text), which the general path reads.
-#[inline]
+#[inline(always)]
 pub(super) fn fast_floats<const N: usize>(b: &[u8], mut i: usize) -> Option<([f32; N], usize)> {
     let mut v = [0f32; N];
     for x in v.iter_mut() {

@@ -181,6 +181,27 @@ impl Piece {
     /// are not checked against what is defined so far, and a relative index stops the parse with
     /// `needs_base` set.
     pub(super) fn parse<const FAST: bool>(&mut self, b: &[u8], base: Option<[u64; 3]>) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::format::mesh::decimal16::available() {
+            // SAFETY: the CPU has SSE4.1, just checked.
+            return unsafe { self.parse_sse41::<FAST>(b, base) };
+        }
+        self.parse_lines::<FAST>(b, base);
+    }
+
+    /// [`Piece::parse`] compiled with SSE4.1, so that the vector number reader is inlined into
+    /// the line reader and its results stay in registers.
+    ///
+    /// # Safety
+    /// The CPU must have SSE4.1.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "sse4.1")]
+    unsafe fn parse_sse41<const FAST: bool>(&mut self, b: &[u8], base: Option<[u64; 3]>) {
+        self.parse_lines::<FAST>(b, base);
+    }
+
+    #[inline(always)]
+    fn parse_lines<const FAST: bool>(&mut self, b: &[u8], base: Option<[u64; 3]>) {
         self.clear();
         let mut i = 0;
         let mut line = 0;
@@ -286,7 +307,7 @@ impl Piece {
 
     /// The line at `i` if it is a common one, parsed; where the next line starts. `None` (nothing
     /// kept) for any other line, which the general path then reads.
-    #[inline]
+    #[inline(always)]
     fn fast_line(&mut self, b: &[u8], i: usize, limit: [u64; 3], corners: &mut Vec<Corner>) -> Option<usize> {
         let (c0, c1) = (b[i], *b.get(i + 1)?);
         if c0 == b'v' {
