@@ -93,7 +93,7 @@ pub fn lead_f32(t: &[u8]) -> Option<(f32, usize)> {
 /// [`lead_f32`] byte by byte: every token the vector reader declines. Out of line, so that the
 /// vector reader's callers stay small enough to inline it and keep its result in registers.
 #[inline(never)]
-fn scalar_f32(t: &[u8]) -> Option<(f32, usize)> {
+pub(in crate::format) fn scalar_f32(t: &[u8]) -> Option<(f32, usize)> {
     let ends = |c: u8| is_space(c) || c == b'\n';
     let slow = || {
         let e = t.iter().position(|&c| ends(c)).unwrap_or(t.len());

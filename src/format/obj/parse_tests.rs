@@ -1,5 +1,5 @@
 use super::*;
-use crate::format::mesh::text_number::{lead_f32, parse_f32};
+use crate::format::mesh::text_number::{lead_f32, parse_f32, scalar_f32};
 use crate::format::mesh::{Statement, MISSING};
 
 fn parse(s: &str) -> StoredMesh {
@@ -140,7 +140,9 @@ fn floats_are_exactly_what_str_parse_gives() {
         for end in [" 0000000000\n", "\r\nv 1 2 3\n", "x1234567890"] {
             let line = format!("{t}{end}");
             let want = if end.starts_with('x') { None } else { want.map(|w| (w.to_bits(), t.len())) };
-            assert_eq!(lead_f32(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want, "{line}");
+            for read in [lead_f32, scalar_f32] {
+                assert_eq!(read(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want, "{line}");
+            }
         }
     }
     // Every f32 midpoint neighbourhood and random decimals of every length.
@@ -155,7 +157,10 @@ fn floats_are_exactly_what_str_parse_gives() {
             assert_eq!(parse_f32(t.as_bytes()).map(f32::to_bits), want, "{t}");
             // Followed by more of the line, the digits are read eight at a time.
             let line = format!("{t} 12345678 9\n");
-            assert_eq!(lead_f32(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want.map(|w| (w, t.len())), "{t}");
+            // The scalar reader too: the one a CPU without SSE4.1 uses for every number.
+            for read in [lead_f32, scalar_f32] {
+                assert_eq!(read(line.as_bytes()).map(|(v, n)| (v.to_bits(), n)), want.map(|w| (w, t.len())), "{t}");
+            }
         }
     }
 }
