@@ -58,7 +58,7 @@ fn fast_index(b: &[u8], mut i: usize, limit: u64) -> Option<(u32, usize)> {
 
 /// A face's corners from `i` on when every one is `v`, `v/vt`, `v//vn` or `v/vt/vn` with positive
 /// indices to what is already defined, followed by the line's end; where the next line starts.
-#[inline]
+#[inline(always)]
 pub(super) fn fast_corners(b: &[u8], mut i: usize, now: [u64; 3], corners: &mut Vec<Corner>) -> Option<usize> {
     corners.clear();
     loop {
