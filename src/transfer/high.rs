@@ -9,7 +9,7 @@
 use crate::error::Result;
 use crate::format::mesh::{check_finite, check_finite_uv, runs, v_down, StoredMesh, MISSING};
 use crate::scene::nodes::instances;
-use crate::scene::normals::unit_or_up;
+use crate::scene::normals::unit_or_up_all;
 use crate::scene::{to_triangle_list, PrimRef, ReadOptions, Scene};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -100,7 +100,7 @@ fn from_stored(path: &Path, m: StoredMesh, first_name: &str) -> Result<HighMesh>
     let mut out = HighMesh { positions: m.positions, triangles: m.triangles, parts, ..Default::default() };
     if let Some(t) = normal_triangles {
         out.normals = m.normals;
-        out.normals.par_iter_mut().for_each(|n| *n = unit_or_up(*n));
+        out.normals.par_chunks_mut(64 * 1024).for_each(unit_or_up_all);
         out.normal_triangles = t;
     }
     if let Some(t) = uv_triangles {
