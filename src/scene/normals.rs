@@ -231,7 +231,7 @@ mod tests {
                 let x = rng.next();
                 [0, 1, 2].map(|k| {
                     let r = x >> (20 * k);
-                    if r % 50 == 0 {
+                    if r.is_multiple_of(50) {
                         odd[(r >> 8) as usize % odd.len()]
                     } else {
                         ((r >> 8) % 2_000_001) as f32 / 1e6 - 1.0
