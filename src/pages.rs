@@ -3,7 +3,8 @@
 //! arrays (the leaf-order triangles, the parsed vertices) are written once, into pages never
 //! touched before, and the faults were a sixth of the tree build's time at 10M triangles
 //! (`docs/transfer-history.md`). What is written, and so every output, is unchanged. And memory
-//! about to be read, asked for ahead (`prefetch`): a hint, which changes nothing either.
+//! about to be read, asked for ahead (`prefetch`), and a file's pages asked of the disk ahead of
+//! its reader (`with_read_ahead`): hints, which change nothing either.
 
 /// Makes the pages of `s` present and writable (Linux 5.14 and later; elsewhere, and where the
 /// kernel declines, the writes fault the pages in as before), on every core.
@@ -12,6 +13,32 @@ pub fn prefault<T>(s: &mut [T]) {
     linux::prefault(s.as_mut_ptr() as usize, std::mem::size_of_val(s));
     #[cfg(not(target_os = "linux"))]
     let _ = s;
+}
+
+/// How far ahead of its reader [`with_read_ahead`] asks for a file's pages: two of the OBJ
+/// reader's blocks, so that the next one is on its way while one is parsed.
+const READ_AHEAD: u64 = 128 << 20;
+/// Bytes a request: the kernel reads at most its readahead window a request (128 KB by
+/// default), so larger requests would be cut short.
+const READ_AHEAD_STEP: u64 = 128 << 10;
+
+/// Runs `read`, which reads `file` (`len` bytes) from its start to its end and tells how far it
+/// has come (a byte offset) through the function it is given, while a thread of its own asks the
+/// kernel for the file's pages up to [`READ_AHEAD`] past that point. A file not wholly in the page
+/// cache (just copied, or partly evicted since it was last read) is then read from disk behind
+/// the reader, in large requests, instead of a page at a time as the reader's threads first
+/// touch it, each waiting for its page. The requests are hints (Linux's `POSIX_FADV_WILLNEED`;
+/// elsewhere there is no thread): nothing read changes, and pages already cached cost a lookup.
+pub fn with_read_ahead<R>(file: &std::fs::File, len: u64, read: impl FnOnce(&dyn Fn(u64)) -> R) -> R {
+    #[cfg(target_os = "linux")]
+    {
+        linux::with_read_ahead(file, len, read)
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = (file, len);
+        read(&|_| {})
+    }
 }
 
 /// The most bytes [`prefetch`] asks for at once (four cache lines).
@@ -45,6 +72,56 @@ mod linux {
     const CHUNK: usize = 4 << 20;
     const PAGE: usize = 4096;
 
+    pub fn with_read_ahead<R>(file: &std::fs::File, len: u64, read: impl FnOnce(&dyn Fn(u64)) -> R) -> R {
+        use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+        let reached = AtomicU64::new(0);
+        let stop = AtomicBool::new(false);
+        std::thread::scope(|s| {
+            let helper = std::thread::Builder::new()
+                .name("read-ahead".into())
+                .spawn_scoped(s, || {
+                    let mut asked = 0;
+                    while asked < len && !stop.load(Ordering::Acquire) {
+                        let until = reached.load(Ordering::Acquire).saturating_add(super::READ_AHEAD).min(len);
+                        if asked < until {
+                            let n = super::READ_AHEAD_STEP.min(until - asked);
+                            will_need(file, asked, n);
+                            asked += n;
+                        } else {
+                            std::thread::park();
+                        }
+                    }
+                })
+                .ok();
+            let wake = || {
+                if let Some(h) = &helper {
+                    h.thread().unpark();
+                }
+            };
+            // Stops the thread however `read` ends, a panic included: the scope waits for it.
+            struct Stop<'a, F: Fn()>(&'a AtomicBool, F);
+            impl<F: Fn()> Drop for Stop<'_, F> {
+                fn drop(&mut self) {
+                    self.0.store(true, Ordering::Release);
+                    (self.1)();
+                }
+            }
+            let _stop = Stop(&stop, wake);
+            read(&|at| {
+                reached.fetch_max(at, Ordering::AcqRel);
+                wake();
+            })
+        })
+    }
+
+    fn will_need(file: &std::fs::File, at: u64, len: u64) {
+        use std::os::fd::AsRawFd;
+        let (Ok(at), Ok(len)) = (libc::off_t::try_from(at), libc::off_t::try_from(len)) else { return };
+        // SAFETY: the call reads no memory of ours; a descriptor it cannot use, or a range past
+        // the end, is declined with an error, which a hint ignores.
+        unsafe { libc::posix_fadvise(file.as_raw_fd(), at, len, libc::POSIX_FADV_WILLNEED) };
+    }
+
     pub fn prefault(at: usize, len: usize) {
         let (start, end) = (at.div_ceil(PAGE) * PAGE, (at + len) / PAGE * PAGE);
         if end < start + MIN_BYTES {
@@ -61,6 +138,27 @@ mod linux {
 
 #[cfg(test)]
 mod tests {
+    /// The reader's result comes back whatever it reports, its reports past the end included, and
+    /// a reader that panics does not leave the helper waiting (the scope would never end).
+    #[test]
+    fn read_ahead_returns_and_ends() {
+        let path = std::env::temp_dir().join(format!("bumpbake-read-ahead-{}", std::process::id()));
+        std::fs::write(&path, vec![7u8; 3 << 20]).unwrap();
+        let file = std::fs::File::open(&path).unwrap();
+        let len = file.metadata().unwrap().len();
+        let sum = super::with_read_ahead(&file, len, |reached| {
+            let bytes = std::fs::read(&path).unwrap();
+            for at in (0..len + (1 << 20)).step_by(1 << 16) {
+                reached(at);
+            }
+            bytes.iter().map(|&b| b as u64).sum::<u64>()
+        });
+        assert_eq!(sum, 7 * (3 << 20));
+        let caught = std::panic::catch_unwind(|| super::with_read_ahead(&file, len, |_| -> u8 { panic!("stop") }));
+        assert!(caught.is_err());
+        std::fs::remove_file(&path).unwrap();
+    }
+
     /// Bytes already written stay as they are, and memory made present is still written
     /// whole by its owner (a vector's spare capacity, as the build and the reader use it).
     #[test]

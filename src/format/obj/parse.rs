@@ -1,8 +1,9 @@
 //! Wavefront OBJ geometry, parsed on every core at memory speed.
 //!
 //! A file is read through a memory map, a window of a block (64 MB) at a time, so its text is
-//! never copied and only one window of it is mapped at once; other readers (a pipe) and bytes in
-//! memory go through the same blocks. Each block is parsed in parallel pieces (`piece.rs`) and
+//! never copied and only one window of it is mapped at once, while a thread asks the disk for the
+//! pages of the next (`pages::with_read_ahead`); other readers (a pipe) and bytes in memory go
+//! through the same blocks. Each block is parsed in parallel pieces (`piece.rs`) and
 //! appended in file order (`block.rs`), so the result never depends on the thread count or the
 //! piece size. Errors name the file's own line numbers.
 //!
@@ -36,7 +37,12 @@ pub fn parse_file(path: &Path, progress: &Reporter) -> Result<StoredMesh> {
             unsafe { memmap2::MmapOptions::new().offset(at).len(n).map(&file) }
         };
         if meta.is_file() && len > 0 && map(0, 1).is_ok() {
-            windows::<true, _>(path, len, piece_for(len), p, |at, n| map(at, n).map_err(cannot))
+            crate::pages::with_read_ahead(&file, len, |reached| {
+                windows::<true, _>(path, len, piece_for(len), p, |at, n| {
+                    reached(at);
+                    map(at, n).map_err(cannot)
+                })
+            })
         } else {
             // Empty, or not mappable (a pipe): read it.
             parse_reader(path, Counting::new(&file, p), piece_for(len))
