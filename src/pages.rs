@@ -15,16 +15,9 @@ pub fn prefault<T>(s: &mut [T]) {
     let _ = s;
 }
 
-/// How far ahead of its reader [`with_read_ahead`] asks for a file's pages: two of the OBJ
-/// reader's blocks, so that the next one is on its way while one is parsed.
-const READ_AHEAD: u64 = 128 << 20;
-/// Bytes a request: the kernel reads at most its readahead window a request (128 KB by
-/// default), so larger requests would be cut short.
-const READ_AHEAD_STEP: u64 = 128 << 10;
-
 /// Runs `read`, which reads `file` (`len` bytes) from its start to its end and tells how far it
 /// has come (a byte offset) through the function it is given, while a thread of its own asks the
-/// kernel for the file's pages up to [`READ_AHEAD`] past that point. A file not wholly in the page
+/// kernel for the file's pages up to 128 MB past that point. A file not wholly in the page
 /// cache (just copied, or partly evicted since it was last read) is then read from disk behind
 /// the reader, in large requests, instead of a page at a time as the reader's threads first
 /// touch it, each waiting for its page. The requests are hints (Linux's `POSIX_FADV_WILLNEED`;
@@ -72,6 +65,13 @@ mod linux {
     const CHUNK: usize = 4 << 20;
     const PAGE: usize = 4096;
 
+    /// How far ahead of its reader `with_read_ahead` asks for a file's pages: two of the OBJ
+    /// reader's blocks, so that the next one is on its way while one is parsed.
+    const READ_AHEAD: u64 = 128 << 20;
+    /// Bytes a request: the kernel reads at most its readahead window a request (128 KB by
+    /// default), so larger requests would be cut short.
+    const READ_AHEAD_STEP: u64 = 128 << 10;
+
     pub fn with_read_ahead<R>(file: &std::fs::File, len: u64, read: impl FnOnce(&dyn Fn(u64)) -> R) -> R {
         use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
         let reached = AtomicU64::new(0);
@@ -82,9 +82,9 @@ mod linux {
                 .spawn_scoped(s, || {
                     let mut asked = 0;
                     while asked < len && !stop.load(Ordering::Acquire) {
-                        let until = reached.load(Ordering::Acquire).saturating_add(super::READ_AHEAD).min(len);
+                        let until = reached.load(Ordering::Acquire).saturating_add(READ_AHEAD).min(len);
                         if asked < until {
-                            let n = super::READ_AHEAD_STEP.min(until - asked);
+                            let n = READ_AHEAD_STEP.min(until - asked);
                             will_need(file, asked, n);
                             asked += n;
                         } else {
