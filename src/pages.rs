@@ -20,7 +20,8 @@ pub fn prefault<T>(s: &mut [T]) {
 /// kernel for the file's pages up to 128 MB past that point. A file not wholly in the page
 /// cache (just copied, or partly evicted since it was last read) is then read from disk behind
 /// the reader, in large requests, instead of a page at a time as the reader's threads first
-/// touch it, each waiting for its page. The requests are hints (Linux's `POSIX_FADV_WILLNEED`;
+/// touch it, each waiting for its page. A file of a few MB is asked for whole before the read, with
+/// no thread. The requests are hints (Linux's `POSIX_FADV_WILLNEED`;
 /// elsewhere there is no thread): nothing read changes, and pages already cached cost a lookup.
 pub fn with_read_ahead<R>(file: &std::fs::File, len: u64, read: impl FnOnce(&dyn Fn(u64)) -> R) -> R {
     #[cfg(target_os = "linux")]
@@ -71,9 +72,19 @@ mod linux {
     /// Bytes a request: the kernel reads at most its readahead window a request (128 KB by
     /// default), so larger requests would be cut short.
     const READ_AHEAD_STEP: u64 = 128 << 10;
+    /// Files up to this size are asked for whole before the read, on the reader's own thread: at
+    /// most 32 requests, where a thread's start and end would cost more than the parse of a
+    /// small file (a batch of many).
+    const READ_AHEAD_INLINE: u64 = 4 << 20;
 
     pub fn with_read_ahead<R>(file: &std::fs::File, len: u64, read: impl FnOnce(&dyn Fn(u64)) -> R) -> R {
         use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+        if len <= READ_AHEAD_INLINE {
+            (0..len)
+                .step_by(READ_AHEAD_STEP as usize)
+                .for_each(|at| will_need(file, at, READ_AHEAD_STEP.min(len - at)));
+            return read(&|_| {});
+        }
         let reached = AtomicU64::new(0);
         let stop = AtomicBool::new(false);
         std::thread::scope(|s| {
@@ -142,21 +153,24 @@ mod tests {
     /// a reader that panics does not leave the helper waiting (the scope would never end).
     #[test]
     fn read_ahead_returns_and_ends() {
-        let path = std::env::temp_dir().join(format!("bumpbake-read-ahead-{}", std::process::id()));
-        std::fs::write(&path, vec![7u8; 3 << 20]).unwrap();
-        let file = std::fs::File::open(&path).unwrap();
-        let len = file.metadata().unwrap().len();
-        let sum = super::with_read_ahead(&file, len, |reached| {
-            let bytes = std::fs::read(&path).unwrap();
-            for at in (0..len + (1 << 20)).step_by(1 << 16) {
-                reached(at);
-            }
-            bytes.iter().map(|&b| b as u64).sum::<u64>()
-        });
-        assert_eq!(sum, 7 * (3 << 20));
-        let caught = std::panic::catch_unwind(|| super::with_read_ahead(&file, len, |_| -> u8 { panic!("stop") }));
-        assert!(caught.is_err());
-        std::fs::remove_file(&path).unwrap();
+        // A small file (hints on the reader's thread) and a larger one (a helper thread).
+        for (k, size) in [3u64 << 20, 9 << 20].into_iter().enumerate() {
+            let path = std::env::temp_dir().join(format!("bumpbake-read-ahead-{}-{k}", std::process::id()));
+            std::fs::write(&path, vec![7u8; size as usize]).unwrap();
+            let file = std::fs::File::open(&path).unwrap();
+            let len = file.metadata().unwrap().len();
+            let sum = super::with_read_ahead(&file, len, |reached| {
+                let bytes = std::fs::read(&path).unwrap();
+                for at in (0..len + (1 << 20)).step_by(1 << 16) {
+                    reached(at);
+                }
+                bytes.iter().map(|&b| b as u64).sum::<u64>()
+            });
+            assert_eq!(sum, 7 * size);
+            let caught = std::panic::catch_unwind(|| super::with_read_ahead(&file, len, |_| -> u8 { panic!("stop") }));
+            assert!(caught.is_err());
+            std::fs::remove_file(&path).unwrap();
+        }
     }
 
     /// Bytes already written stay as they are, and memory made present is still written
