@@ -255,7 +255,7 @@ pub fn bake_from(scene: &Scene, materials: &[usize], s: &Settings, high: Vec<Hig
         ray_back: back,
         counts: counts_all,
         height_range,
-        bvh_nodes: sets.bvhs.iter().map(|b| b.nodes.len()).sum(),
+        bvh_nodes: sets.bvhs.iter().map(|b| b.node_count()).sum(),
         high_bytes,
         matching: if s.matching == Match::Auto { "auto" } else { "none" }.to_string(),
         pairs: groups

@@ -2,7 +2,6 @@
 //! as many nodes as in the binary tree, and tests a node's four boxes at once.
 
 use super::node::{Node, WideNode};
-use rayon::prelude::*;
 
 /// A tree that is one leaf: a root with that leaf as its only child.
 fn lone_leaf(leaf: &Node) -> Vec<WideNode> {
@@ -78,98 +77,123 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Vec<WideNode>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// The tree as the Morton build leaves it: binary splits over ranges, each range collapsed to
-/// its own four-wide tree on the core that built it, while its nodes are still in cache. A
-/// split carries its box in a [`Node`].
+/// The four-wide tree over the binary tree `bin` (root at 0), root at 0: a tree built without
+/// Morton ranges (a small HIGH).
+pub(super) fn whole(bin: &[Node]) -> Vec<WideNode> {
+    if bin[0].is_leaf() {
+        return lone_leaf(&bin[0]);
+    }
+    let mut out = Vec::new();
+    collapse_inner(bin, 0, &mut out);
+    out
+}
+
+/// Where the ranges of a part of the Morton build put their four-wide nodes: the part of the
+/// tree's node array that its triangles' places address (a tree over `t` triangles has at most
+/// `t - 1` four-wide nodes, each on two binary inner nodes or more, so parts never overlap).
+/// The ranges of a part built on one thread append one after the other, so its nodes stay
+/// together and the rest of its slots are never written: in a mapping that makes them pages
+/// never made present (`node.rs`).
+pub(super) struct Slots<'a> {
+    nodes: &'a mut [WideNode],
+    /// The index in the whole array of `nodes[0]`.
+    at: usize,
+    used: usize,
+}
+
+impl<'a> Slots<'a> {
+    pub fn new(nodes: &'a mut [WideNode], at: usize) -> Slots<'a> {
+        Slots { nodes, at, used: 0 }
+    }
+
+    /// The first `k` slots and the rest, for two parts built apart; none may be used yet.
+    pub fn split_at(&mut self, k: usize) -> (Slots<'_>, Slots<'_>) {
+        debug_assert_eq!(self.used, 0, "a part built on one thread is not split again");
+        let (a, b) = self.nodes.split_at_mut(k);
+        (Slots::new(a, self.at), Slots::new(b, self.at + k))
+    }
+
+    /// A range over the binary tree `bin` (root at 0), its four-wide tree collapsed in a buffer
+    /// each thread reuses (while the range's nodes are still in cache) and copied into the next
+    /// free slots, its inner children pointed at their places there.
+    pub fn range(&mut self, bin: &[Node]) -> Upper {
+        if bin[0].is_leaf() {
+            return Upper::Range(bin[0], 0, 0);
+        }
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            s.clear();
+            collapse_inner(bin, 0, &mut s);
+            let at = self.at + self.used;
+            let shift = u32::try_from(at).expect("node indices fit 32 bits");
+            let to =
+                self.nodes.get_mut(self.used..self.used + s.len()).expect("a range has fewer nodes than triangles");
+            for (slot, n) in to.iter_mut().zip(s.iter()) {
+                let mut n = *n;
+                for k in 0..4 {
+                    if n.has(k) && !n.is_leaf(k) {
+                        n.child[k] += shift;
+                    }
+                }
+                *slot = n;
+            }
+            self.used += s.len();
+            let len = s.len() as u32;
+            // A pile of duplicates built as one range can be large: not held on to.
+            if s.capacity() > SCRATCH_KEPT {
+                *s = Vec::new();
+            }
+            Upper::Range(bin[0], shift, len)
+        })
+    }
+}
+
+/// The tree as the Morton build leaves it: binary splits over ranges, each range's four-wide
+/// tree already in its slots of the node array. A split carries its box in a [`Node`].
 pub(super) enum Upper {
-    /// A range's binary root (its box, or the leaf it is) and its four-wide tree (empty when
-    /// the root is a leaf).
-    Range(Node, Vec<WideNode>),
+    /// A range's binary root (its box, or the leaf it is), the index of its four-wide root in
+    /// the node array and its count of four-wide nodes (0 when the root is a leaf).
+    Range(Node, u32, u32),
     Split(Node, Box<Upper>, Box<Upper>),
 }
 
 impl Upper {
-    /// A range over the binary tree `bin` (root at 0). Collapsed in a buffer each thread
-    /// reuses, then copied out at its size: tens of thousands of ranges at 10M triangles, and a
-    /// vector each grown to fit cost their allocations and copies.
-    pub fn range(bin: &[Node]) -> Upper {
-        if bin[0].is_leaf() {
-            return Upper::Range(bin[0], Vec::new());
-        }
-        let wide = SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            s.clear();
-            collapse_inner(bin, 0, &mut s);
-            let wide = s.to_vec();
-            // A whole tree built without ranges (a small HIGH) is not held on to.
-            if s.capacity() > SCRATCH_KEPT {
-                *s = Vec::new();
-            }
-            wide
-        });
-        Upper::Range(bin[0], wide)
-    }
-
     /// Its binary root's box.
     pub fn node(&self) -> &Node {
         match self {
-            Upper::Range(n, _) | Upper::Split(n, ..) => n,
+            Upper::Range(n, ..) | Upper::Split(n, ..) => n,
         }
     }
 
-    /// The four-wide tree, root at 0: the splits collapsed as a binary tree is (a range's
-    /// root is not opened into the node above it), then every range's tree appended in the
-    /// order the splits meet them, its inner children shifted as it is copied.
-    pub fn collapse(self) -> Vec<WideNode> {
+    /// The four-wide nodes over the splits, written from `nodes[0]` (the root), collapsed as a
+    /// binary tree is (a range's root is not opened into the node above it), their lanes
+    /// pointed at the ranges' roots in their slots; returns how many nodes the whole tree has.
+    /// The nodes above the ranges go in the first `front` slots.
+    pub fn collapse(self, nodes: &mut [WideNode], front: usize) -> usize {
         match self {
-            Upper::Range(root, _) if root.is_leaf() => return lone_leaf(&root),
-            Upper::Range(_, wide) => return wide,
+            Upper::Range(root, ..) if root.is_leaf() => {
+                nodes[0] = lone_leaf(&root)[0];
+                return 1;
+            }
+            // One range: its root, whose children are placed already, copied to the front.
+            Upper::Range(_, at, len) => {
+                nodes[0] = nodes[at as usize];
+                return len as usize;
+            }
             Upper::Split(..) => {}
         }
-        let (mut out, mut later) = (Vec::new(), Vec::new());
-        collapse_split(&self, &mut out, &mut later);
-        // Each range's tree goes after the upper nodes, in the order the splits met them; the
-        // copies (tens of MB at 10M triangles, into new pages) run on every core.
-        let base = out.len();
-        let mut starts = Vec::with_capacity(later.len() + 1);
-        starts.push(0);
-        for &(me, lane, wide) in &later {
-            let start = *starts.last().expect("starts at 0");
-            out[me].child[lane] = (base + start) as u32;
-            starts.push(start + wide.len());
-        }
-        let total = *starts.last().expect("starts at 0");
-        out.reserve_exact(total);
-        crate::pages::prefault(out.spare_capacity_mut());
-        // Each task walks its indices upwards, so the range holding index `i` is found by one
-        // search per task and then by stepping on.
-        out.par_extend((0..total).into_par_iter().map_init(
-            || usize::MAX,
-            |r, i| {
-                if *r == usize::MAX || i < starts[*r] {
-                    *r = starts.partition_point(|&s| s <= i) - 1;
-                }
-                while i >= starts[*r + 1] {
-                    *r += 1;
-                }
-                let mut n = later[*r].2[i - starts[*r]];
-                let at = (base + starts[*r]) as u32;
-                for k in 0..4 {
-                    if n.has(k) && !n.is_leaf(k) {
-                        n.child[k] += at;
-                    }
-                }
-                n
-            },
-        ));
-        out
+        let mut out = Vec::new();
+        let ranges = collapse_split(&self, &mut out);
+        assert!(out.len() <= front, "room for the nodes above the ranges");
+        nodes[..out.len()].copy_from_slice(&out);
+        out.len() + ranges
     }
 }
 
-/// The wide node for split `s`, as [`collapse_inner`] builds one; lanes whose child is a
-/// range's root (not a leaf) are listed in `later` as (node, lane, the range's tree) to be
-/// pointed at it once placed.
-fn collapse_split<'a>(s: &'a Upper, out: &mut Vec<WideNode>, later: &mut Vec<(usize, usize, &'a [WideNode])>) -> u32 {
+/// The wide node for split `s`, as [`collapse_inner`] builds one, pushed to `out` (whose
+/// indices are the node array's); lanes whose child is a range's root point at its slot.
+/// Returns the four-wide nodes of the ranges below.
+fn collapse_split<'a>(s: &'a Upper, out: &mut Vec<WideNode>) -> usize {
     let Upper::Split(_, l, r) = s else { unreachable!("collapse_split is given splits") };
     let inner = |k: &'a Upper| match k {
         Upper::Split(n, a, b) => Some((n.area(), &**a, &**b)),
@@ -179,17 +203,24 @@ fn collapse_split<'a>(s: &'a Upper, out: &mut Vec<WideNode>, later: &mut Vec<(us
     let me = out.len();
     out.push(WideNode::empty());
     let mut w = WideNode::empty();
+    let mut ranges = 0;
     for (lane, k) in kids[..len].iter().enumerate() {
         w.set_box(lane, k.node());
         match k {
-            Upper::Split(..) => w.child[lane] = collapse_split(k, out, later),
-            Upper::Range(root, _) if root.is_leaf() => {
+            Upper::Split(..) => {
+                w.child[lane] = out.len() as u32;
+                ranges += collapse_split(k, out);
+            }
+            Upper::Range(root, ..) if root.is_leaf() => {
                 w.child[lane] = root.right_or_first;
                 w.count[lane] = leaf_count(root);
             }
-            Upper::Range(_, wide) => later.push((me, lane, wide)),
+            Upper::Range(_, at, n) => {
+                w.child[lane] = *at;
+                ranges += *n as usize;
+            }
         }
     }
     out[me] = w;
-    me as u32
+    ranges
 }

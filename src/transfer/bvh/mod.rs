@@ -25,7 +25,7 @@ mod sah;
 mod small;
 
 use bounds::{bounds_of, Item};
-use collapse::Upper;
+use node::Nodes;
 pub use node::WideNode;
 
 /// Ranges smaller than this are built, bounded and binned on the current thread.
@@ -33,8 +33,10 @@ const PARALLEL_MIN: usize = 16 * 1024;
 
 #[derive(Debug, Clone)]
 pub struct Bvh {
-    /// The four-wide nodes, root at 0, each before its children.
-    pub nodes: Vec<WideNode>,
+    /// The four-wide nodes, root at 0 (on a large HIGH, among unused slots of zeros).
+    pub nodes: Nodes,
+    /// How many of `nodes` the tree uses.
+    count: usize,
     /// Each leaf-order triangle's index in the input.
     pub ids: Vec<u32>,
     /// The triangles in leaf order: a leaf's triangles are read from one place, not through
@@ -70,7 +72,7 @@ impl Bvh {
         use rayon::prelude::*;
         let n = triangles.len();
         if n == 0 {
-            return Bvh { nodes: Vec::new(), ids: Vec::new(), tris: Vec::new() };
+            return Bvh { nodes: Nodes::heap(Vec::new()), count: 0, ids: Vec::new(), tris: Vec::new() };
         }
         // Spelled out, not `t.map(..)`: the array's `map` was left out of line here, built the
         // corners on the stack and read them back whole before their stores had landed, and
@@ -85,20 +87,19 @@ impl Bvh {
         if morton::applies(n) {
             // Each range writes its triangles in leaf order as it ends, while they are cached:
             // no array of items, no pass of its own over HIGH in leaf order.
-            let (upper, ids, tris) = morton::build(n, &corners, &tri);
+            let (nodes, count, ids, tris) = morton::build(n, &corners, &tri);
             drop(triangles);
-            return Bvh { nodes: upper.collapse(), ids, tris };
+            return Bvh { nodes, count, ids, tris };
         }
         let mut items: Vec<Item> = (0..n).into_par_iter().map(item).collect();
         let bc = bounds_of(&items);
-        let upper = Upper::range(&sah::build_par(&mut items, 0, bc));
+        let wide = collapse::whole(&sah::build_par(&mut items, 0, bc));
         let ids: Vec<u32> = items.par_iter().map(|it| it.id).collect();
         // Each array is dropped as soon as the next is made from it: the build's peak is what
         // bounds memory on a large HIGH.
         drop(items);
-        let nodes = upper.collapse();
         let tris = ids.par_iter().map(|&i| tri(i)).collect();
-        Bvh { nodes, ids, tris }
+        Bvh { count: wide.len(), nodes: Nodes::heap(wide), ids, tris }
     }
 
     /// An empty tree has no nodes.
@@ -134,9 +135,14 @@ impl Bvh {
         }
     }
 
-    /// Bytes held, for the memory figures.
+    /// How many four-wide nodes the tree has.
+    pub fn node_count(&self) -> usize {
+        self.count
+    }
+
+    /// Bytes held, for the memory figures (the nodes' unused slots are never made present).
     pub fn bytes(&self) -> usize {
-        self.nodes.capacity() * std::mem::size_of::<WideNode>()
+        self.count * std::mem::size_of::<WideNode>()
             + self.tris.capacity() * std::mem::size_of::<Tri>()
             + self.ids.capacity() * 4
     }
@@ -181,8 +187,10 @@ pub(crate) mod tests {
     fn covered_once_and_nested(tris: &[[Vec3A; 3]]) {
         let (bvh, _) = soup(tris);
         let mut seen = vec![0u32; tris.len()];
+        let mut visited = 0;
         // The box of what node `i`'s lanes hold, each checked against the lane's own box.
-        fn walk(b: &Bvh, i: usize, seen: &mut [u32]) -> Aabb {
+        fn walk(b: &Bvh, i: usize, seen: &mut [u32], visited: &mut usize) -> Aabb {
+            *visited += 1;
             let n = b.nodes[i];
             let mut all = Aabb::EMPTY;
             for lane in (0..4).filter(|&k| n.has(k)) {
@@ -197,7 +205,7 @@ pub(crate) mod tests {
                     }
                     a
                 } else {
-                    walk(b, n.child[lane] as usize, seen)
+                    walk(b, n.child[lane] as usize, seen, visited)
                 };
                 assert!(
                     lo.cmple(held.min).all() && hi.cmpge(held.max).all(),
@@ -207,10 +215,12 @@ pub(crate) mod tests {
             }
             all
         }
-        walk(&bvh, 0, &mut seen);
+        walk(&bvh, 0, &mut seen, &mut visited);
         assert!(seen.iter().all(|&s| s == 1));
-        // Four-wide: far fewer nodes than triangles.
-        assert!(bvh.nodes.len() * 4 < tris.len(), "{} nodes", bvh.nodes.len());
+        // Every node counted is in the tree (the unused slots are not), and four-wide: far fewer
+        // nodes than triangles.
+        assert_eq!(visited, bvh.node_count());
+        assert!(bvh.node_count() * 4 < tris.len(), "{} nodes", bvh.node_count());
     }
 
     /// On a large HIGH a quad's two halves are one item (`pairs.rs`): side by side in one leaf.

@@ -3,9 +3,9 @@
 //! items fit in a core's cache. An item is a triangle or a pair of neighbours (`pairs.rs`).
 
 use super::bounds::{bounds_of, Aabb, Item};
-use super::collapse::Upper;
+use super::collapse::{Slots, Upper};
 use super::local::LOCAL;
-use super::node::Node;
+use super::node::{Node, Nodes};
 use super::pairs::{self, Pairs};
 use super::range;
 use super::sah;
@@ -38,11 +38,12 @@ pub(super) fn applies(n: usize) -> bool {
 }
 
 /// Builds the tree over the `n` triangles whose corners `corners` gives, its items in the
-/// order of the Morton codes of their centres; returns it, the
-/// triangles' ids in leaf order and `tri` of each id in that order. The items are never
-/// gathered into that order: each range computes its own from the mesh, and writes its
-/// triangles in leaf order into their place.
-pub(super) fn build<C, T>(n: usize, corners: &C, tri: &T) -> (Upper, Vec<u32>, Vec<Tri>)
+/// order of the Morton codes of their centres; returns its four-wide nodes (root at 0) and how
+/// many there are (the rest are unused slots), the triangles' ids in leaf order and `tri` of
+/// each id in that order. The items are never gathered into that order: each range computes
+/// its own from the mesh, and writes its triangles in leaf order, and its four-wide nodes, into
+/// their places.
+pub(super) fn build<C, T>(n: usize, corners: &C, tri: &T) -> (Nodes, usize, Vec<u32>, Vec<Tri>)
 where
     C: Fn(usize) -> [[f32; 3]; 3] + Sync,
     T: Fn(u32) -> Tri + Sync,
@@ -57,14 +58,28 @@ where
     crate::pages::prefault(tris.spare_capacity_mut());
     crate::pages::prefault(ids.spare_capacity_mut());
     let out = Out { tris: &mut tris.spare_capacity_mut()[..n], ids: &mut ids.spare_capacity_mut()[..n] };
-    let upper = build_upper(&Mesh { item: &item, tri, pairs: &pairs }, &mut keys, &starts, out);
+    // The nodes above the ranges first, then a slot a triangle for the ranges' nodes: each part
+    // of the build writes its own once, where it ends, with no copy into one array after.
+    let front = front_slots(keys.len());
+    let mut nodes = Nodes::zeroed(front + n);
+    let mut slots = Slots::new(&mut nodes[front..], front);
+    let upper = build_upper(&Mesh { item: &item, tri, pairs: &pairs }, &mut keys, &starts, out, &mut slots);
+    let count = upper.collapse(&mut nodes, front);
     // SAFETY: the ranges split the keys without gaps, the slots in step with their triangles,
     // and each range writes every slot of its own (`range`), so all `n` are written.
     unsafe {
         tris.set_len(n);
         ids.set_len(n);
     }
-    (upper, ids, tris)
+    (nodes, count, ids, tris)
+}
+
+/// Room for the four-wide nodes above the ranges of `items` items: at most one a binary split.
+/// A split has more than [`SAH_RANGE`] items, so the splits at one depth hold that many
+/// apart, and each split is at a lower bit of the code than its parent's (its items share
+/// the bits above), so there are at most as many depths as the code has bits.
+fn front_slots(items: usize) -> usize {
+    (3 * AXIS_BITS) as usize * (items / (SAH_RANGE + 1)) + 1
 }
 
 /// What the ranges read the mesh through: a triangle's item, its record in leaf order, and
@@ -217,7 +232,7 @@ fn upper_bounds(u: &Upper) -> Aabb {
 /// triangles start at `starts` in leaf order: each split where the codes' highest differing bit
 /// flips; ranges of [`SAH_RANGE`] or fewer (or of one code) are built by binned SAH. Writes
 /// each slot of `out` (as many as the items' triangles), in leaf order.
-fn build_upper<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], starts: &[u32], out: Out) -> Upper
+fn build_upper<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], starts: &[u32], out: Out, slots: &mut Slots) -> Upper
 where
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
@@ -225,17 +240,20 @@ where
     let code = |k: u64| k >> INDEX_BITS;
     let (first, last) = (code(keys[0]), code(keys[keys.len() - 1]));
     if keys.len() <= SAH_RANGE || first == last {
-        return range(mesh, keys, starts[0] as usize, out);
+        return range(mesh, keys, starts[0] as usize, out, slots);
     }
     let bit = 63 - (first ^ last).leading_zeros();
     let mid = keys.partition_point(|&k| code(k) >> bit & 1 == 0);
     let (l, r) = keys.split_at_mut(mid);
     let (ls, rs) = starts.split_at(mid);
     let (lo, ro) = out.split_at((rs[0] - ls[0]) as usize);
+    // Built on this thread, both sides' ranges put their nodes in the same slots one after the
+    // other; on two, each side takes the slots of its triangles.
     let (left, right) = if l.len() + r.len() < SERIAL_BELOW {
-        (build_upper(mesh, l, ls, lo), build_upper(mesh, r, rs, ro))
+        (build_upper(mesh, l, ls, lo, slots), build_upper(mesh, r, rs, ro, slots))
     } else {
-        rayon::join(|| build_upper(mesh, l, ls, lo), || build_upper(mesh, r, rs, ro))
+        let (mut sl, mut sr) = slots.split_at((rs[0] - ls[0]) as usize);
+        rayon::join(|| build_upper(mesh, l, ls, lo, &mut sl), || build_upper(mesh, r, rs, ro, &mut sr))
     };
     let mut b = upper_bounds(&left);
     b.join(&upper_bounds(&right));
@@ -248,8 +266,8 @@ thread_local! {
 }
 
 /// The tree over the range of items `keys` names, their triangles starting at `offset` in leaf
-/// order; writes every slot of `out`.
-fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], offset: usize, out: Out) -> Upper
+/// order; writes every slot of `out`, and its four-wide nodes into the next of `slots`.
+fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], offset: usize, out: Out, slots: &mut Slots) -> Upper
 where
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
@@ -263,7 +281,7 @@ where
             nodes.clear();
             range::build_by_index(item, keys, offset, &mut nodes);
             write(mesh, out, keys.iter().flat_map(triangles));
-            Upper::range(&nodes)
+            slots.range(&nodes)
         });
     }
     // Many items with one code (a pile of duplicates): their triangles gathered one by one, then
@@ -272,7 +290,7 @@ where
     let bc = bounds_of(&gathered);
     let nodes = sah::build_par(&mut gathered, offset, bc);
     write(mesh, out, gathered.iter().map(|it| it.id));
-    Upper::range(&nodes)
+    slots.range(&nodes)
 }
 
 /// Writes the triangles `ids` (as many as `out` has slots) and their ids into `out`: the range's

@@ -80,5 +80,66 @@ impl WideNode {
     }
 }
 
+/// A tree's four-wide nodes, as the rays index them: a vector, or on a large HIGH a zeroed
+/// mapping in which each part of the build wrote its nodes into slots of its own (`morton.rs`):
+/// the slots left over hold zeros (no lanes), are never read, and stay pages never made present.
+pub struct Nodes(Store);
+
+enum Store {
+    Heap(Vec<WideNode>),
+    Mapped(memmap2::MmapMut, usize),
+}
+
+impl Nodes {
+    pub(super) fn heap(v: Vec<WideNode>) -> Nodes {
+        Nodes(Store::Heap(v))
+    }
+
+    /// `len` nodes of zeros, their pages made present only where written.
+    pub(super) fn zeroed(len: usize) -> Nodes {
+        let bytes = len * std::mem::size_of::<WideNode>();
+        match memmap2::MmapOptions::new().len(bytes.max(1)).no_reserve_swap().map_anon() {
+            Ok(map) => Nodes(Store::Mapped(map, len)),
+            // No mapping to be had: the same zeros, made present now.
+            Err(_) => Nodes::heap(vec![WideNode::empty(); len]),
+        }
+    }
+}
+
+impl std::ops::Deref for Nodes {
+    type Target = [WideNode];
+    fn deref(&self) -> &[WideNode] {
+        match &self.0 {
+            Store::Heap(v) => v,
+            // SAFETY: the mapping holds `len` nodes' bytes, page-aligned (beyond a node's 64);
+            // each is zeros, which is a node (all its fields are numbers), or a node written
+            // through `deref_mut`; it lives as long as `self`.
+            Store::Mapped(map, len) => unsafe { std::slice::from_raw_parts(map.as_ptr().cast(), *len) },
+        }
+    }
+}
+
+impl std::ops::DerefMut for Nodes {
+    fn deref_mut(&mut self) -> &mut [WideNode] {
+        match &mut self.0 {
+            Store::Heap(v) => v,
+            // SAFETY: as in `deref`, and `&mut self` makes the borrow unique.
+            Store::Mapped(map, len) => unsafe { std::slice::from_raw_parts_mut(map.as_mut_ptr().cast(), *len) },
+        }
+    }
+}
+
+impl Clone for Nodes {
+    fn clone(&self) -> Nodes {
+        Nodes::heap(self.to_vec())
+    }
+}
+
+impl std::fmt::Debug for Nodes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Nodes({})", self.len())
+    }
+}
+
 // The sizes the comments above and the memory figures count on.
 const _: () = assert!(std::mem::size_of::<Node>() == 32 && std::mem::size_of::<WideNode>() == 128);
