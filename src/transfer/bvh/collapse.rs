@@ -3,13 +3,13 @@
 
 use super::node::{Node, WideNode};
 
-/// A tree that is one leaf: a root with that leaf as its only child.
-fn lone_leaf(leaf: &Node) -> Vec<WideNode> {
+/// The root of a tree that is one leaf: that leaf as its only child.
+fn lone_leaf(leaf: &Node) -> WideNode {
     let mut w = WideNode::empty();
     w.set_box(0, leaf);
     w.child[0] = leaf.right_or_first;
     w.count[0] = leaf_count(leaf);
-    vec![w]
+    w
 }
 
 fn leaf_count(n: &Node) -> u8 {
@@ -81,7 +81,7 @@ thread_local! {
 /// Morton ranges (a small HIGH).
 pub(super) fn whole(bin: &[Node]) -> Vec<WideNode> {
     if bin[0].is_leaf() {
-        return lone_leaf(&bin[0]);
+        return vec![lone_leaf(&bin[0])];
     }
     let mut out = Vec::new();
     collapse_inner(bin, 0, &mut out);
@@ -172,7 +172,7 @@ impl Upper {
     pub fn collapse(self, nodes: &mut [WideNode], front: usize) -> usize {
         match self {
             Upper::Range(root, ..) if root.is_leaf() => {
-                nodes[0] = lone_leaf(&root)[0];
+                nodes[0] = lone_leaf(&root);
                 return 1;
             }
             // One range: its root, whose children are placed already, copied to the front.
