@@ -185,6 +185,14 @@ pub(crate) mod tests {
     }
 
     fn covered_once_and_nested(tris: &[[Vec3A; 3]]) {
+        let bvh = whole_and_nested(tris);
+        // Four-wide: far fewer nodes than triangles.
+        assert!(bvh.node_count() * 4 < tris.len(), "{} nodes", bvh.node_count());
+    }
+
+    /// The tree over `tris`: every triangle in one leaf, every node's box holding its children's,
+    /// and every node counted in the tree (the unused slots are not).
+    fn whole_and_nested(tris: &[[Vec3A; 3]]) -> Bvh {
         let (bvh, _) = soup(tris);
         let mut seen = vec![0u32; tris.len()];
         let mut visited = 0;
@@ -217,10 +225,8 @@ pub(crate) mod tests {
         }
         walk(&bvh, 0, &mut seen, &mut visited);
         assert!(seen.iter().all(|&s| s == 1));
-        // Every node counted is in the tree (the unused slots are not), and four-wide: far fewer
-        // nodes than triangles.
         assert_eq!(visited, bvh.node_count());
-        assert!(bvh.node_count() * 4 < tris.len(), "{} nodes", bvh.node_count());
+        bvh
     }
 
     /// On a large HIGH a quad's two halves are one item (`pairs.rs`): side by side in one leaf.
@@ -277,5 +283,15 @@ pub(crate) mod tests {
                 covered_once_and_nested(&tris);
             }
         }
+    }
+
+    /// A large HIGH whose items all have one Morton code is one range with no split above it:
+    /// its root, placed among the slots, stands at 0 too, and the tree is whole (split by count:
+    /// the centres cannot be told apart, so not four triangles a node).
+    #[test]
+    fn one_code_is_one_range_rooted_at_0() {
+        let t = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
+        let tris = vec![t; morton::MORTON_MIN];
+        assert!(whole_and_nested(&tris).node_count() > 1);
     }
 }
