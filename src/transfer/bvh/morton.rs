@@ -37,16 +37,17 @@ pub(super) fn applies(n: usize) -> bool {
     (MORTON_MIN..1 << INDEX_BITS).contains(&n)
 }
 
-/// Builds the tree over the `n` triangles whose corners `corners` gives, its items in the
-/// order of the Morton codes of their centres; returns its four-wide nodes (root at 0) and how
+/// Builds the tree over the `n` triangles whose corners `corners` gives (`warm` as in
+/// [`Mesh`]), its items in the order of the Morton codes of their centres; returns its four-wide nodes (root at 0) and how
 /// many there are (the rest are unused slots), the triangles' ids in leaf order and `tri` of
 /// each id in that order. The items are never gathered into that order: each range computes
 /// its own from the mesh, and writes its triangles in leaf order, and its four-wide nodes, into
 /// their places.
-pub(super) fn build<C, T>(n: usize, corners: &C, tri: &T) -> (Nodes, usize, Vec<u32>, Vec<Tri>)
+pub(super) fn build<C, T, W>(n: usize, corners: &C, tri: &T, warm: &W) -> (Nodes, usize, Vec<u32>, Vec<Tri>)
 where
     C: Fn(usize) -> [[f32; 3]; 3] + Sync,
     T: Fn(u32) -> Tri + Sync,
+    W: Fn(usize, usize, bool) + Sync,
 {
     let item = |i: usize| Item::of(&corners(i), i as u32);
     let found = pairs::find(n, corners);
@@ -63,7 +64,7 @@ where
     let front = front_slots(keys.len());
     let mut nodes = Nodes::zeroed(front + n);
     let mut slots = Slots::new(&mut nodes[front..], front);
-    let upper = build_upper(&Mesh { item: &item, tri, pairs: &pairs }, &mut keys, &starts, out, &mut slots);
+    let upper = build_upper(&Mesh { item: &item, tri, pairs: &pairs, warm }, &mut keys, &starts, out, &mut slots);
     let count = upper.collapse(&mut nodes, front);
     // SAFETY: the ranges split the keys without gaps, the slots in step with their triangles,
     // and each range writes every slot of its own (`range`), so all `n` are written.
@@ -82,12 +83,15 @@ fn front_slots(items: usize) -> usize {
     (3 * AXIS_BITS) as usize * (items / (SAH_RANGE + 1)) + 1
 }
 
-/// What the ranges read the mesh through: a triangle's item, its record in leaf order, and
-/// which triangles are paired.
-struct Mesh<'a, I, T> {
+/// What the ranges read the mesh through: a triangle's item, its record in leaf order, which
+/// triangles are paired, and `warm(t, n, deep)`, which asks the CPU for what the items of
+/// triangles `t..t + n` read (their records, or with `deep` their corners, read from the
+/// records a first call asked for).
+struct Mesh<'a, I, T, W> {
     item: &'a I,
     tri: &'a T,
     pairs: &'a Pairs,
+    warm: &'a W,
 }
 
 /// Where a range writes its triangles and their ids, in leaf order.
@@ -232,10 +236,11 @@ fn upper_bounds(u: &Upper) -> Aabb {
 /// triangles start at `starts` in leaf order: each split where the codes' highest differing bit
 /// flips; ranges of [`SAH_RANGE`] or fewer (or of one code) are built by binned SAH. Writes
 /// each slot of `out` (as many as the items' triangles), in leaf order.
-fn build_upper<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], starts: &[u32], out: Out, slots: &mut Slots) -> Upper
+fn build_upper<I, T, W>(mesh: &Mesh<I, T, W>, keys: &mut [u64], starts: &[u32], out: Out, slots: &mut Slots) -> Upper
 where
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
+    W: Fn(usize, usize, bool) + Sync,
 {
     let code = |k: u64| k >> INDEX_BITS;
     let (first, last) = (code(keys[0]), code(keys[keys.len() - 1]));
@@ -267,14 +272,21 @@ thread_local! {
 
 /// The tree over the range of items `keys` names, their triangles starting at `offset` in leaf
 /// order; writes every slot of `out`, and its four-wide nodes into the next of `slots`.
-fn range<I, T>(mesh: &Mesh<I, T>, keys: &mut [u64], offset: usize, out: Out, slots: &mut Slots) -> Upper
+fn range<I, T, W>(mesh: &Mesh<I, T, W>, keys: &mut [u64], offset: usize, out: Out, slots: &mut Slots) -> Upper
 where
     I: Fn(usize) -> Item + Sync,
     T: Fn(u32) -> Tri + Sync,
+    W: Fn(usize, usize, bool) + Sync,
 {
     keys.iter_mut().for_each(|k| *k &= INDEX_MASK);
     let triangles = |k: &u64| (*k as u32..).take(mesh.pairs.size(*k as u32) as usize);
     if keys.len() <= LOCAL {
+        // Neighbours in space, the range's items are scattered over HIGH's arrays: their
+        // records, then their corners, are asked for all at once ahead of the build, which
+        // would otherwise wait on each item's in turn (`docs/transfer-history.md`).
+        for deep in [false, true] {
+            keys.iter().for_each(|&k| (mesh.warm)(k as usize, mesh.pairs.size(k as u32) as usize, deep));
+        }
         let item = |t: usize| (mesh.pairs.item(t as u32, mesh.item), mesh.pairs.size(t as u32) as u8);
         return BIN.with(|b| {
             let mut nodes = b.borrow_mut();
@@ -295,7 +307,7 @@ where
 
 /// Writes the triangles `ids` (as many as `out` has slots) and their ids into `out`: the range's
 /// triangles were just read for their items, and are still in cache.
-fn write<I, T: Fn(u32) -> Tri>(mesh: &Mesh<I, T>, out: Out, ids: impl Iterator<Item = u32>) {
+fn write<I, T: Fn(u32) -> Tri, W>(mesh: &Mesh<I, T, W>, out: Out, ids: impl Iterator<Item = u32>) {
     let mut n = 0;
     for ((slot, id), t) in out.tris.iter_mut().zip(out.ids.iter_mut()).zip(ids) {
         slot.write((mesh.tri)(t));
