@@ -38,11 +38,11 @@ pub(super) fn applies(n: usize) -> bool {
 }
 
 /// Builds the tree over the `n` triangles whose corners `corners` gives (`warm` as in
-/// [`Mesh`]), its items in the order of the Morton codes of their centres; returns its four-wide nodes (root at 0) and how
-/// many there are (the rest are unused slots), the triangles' ids in leaf order and `tri` of
-/// each id in that order. The items are never gathered into that order: each range computes
-/// its own from the mesh, and writes its triangles in leaf order, and its four-wide nodes, into
-/// their places.
+/// [`Mesh`]), its items in the order of the Morton codes of their centres; returns its
+/// four-wide nodes (root at 0) and how many there are (the rest are unused slots), the
+/// triangles' ids in leaf order and `tri` of each id in that order. The items are never
+/// gathered into that order: each range computes its own from the mesh, and writes its
+/// triangles in leaf order, and its four-wide nodes, into their places.
 pub(super) fn build<C, T, W>(n: usize, corners: &C, tri: &T, warm: &W) -> (Nodes, usize, Vec<u32>, Vec<Tri>)
 where
     C: Fn(usize) -> [[f32; 3]; 3] + Sync,
